@@ -1,0 +1,55 @@
+"""barhinge: bar-and-hinge structural analysis of origami tessellations.
+
+The public API (see docs/ and DESIGN.md §4) is re-exported here lazily, so ``import barhinge``
+stays cheap and never imports rendering libraries.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+from barhinge.actuators import Actuators
+from barhinge.errors import BarhingeError, ConfigError, ConvergenceError, PatternError
+from barhinge.pattern.crease import CreasePattern
+from barhinge.results import FoldPath
+
+__version__ = "0.1.0"
+
+# name -> module that defines it (imported on first use)
+_LAZY = {
+    "read": "barhinge.pattern.io",
+    "read_fold": "barhinge.pattern.fold",
+    "write_fold": "barhinge.pattern.fold",
+    "read_svg": "barhinge.pattern.svg",
+    "patterns": "barhinge.patterns",
+    "dof": "barhinge.kinematics.dof",
+    "rigid_fold": "barhinge.kinematics.path",
+    "BarHingeModel": "barhinge.model.model",
+    "Material": "barhinge.model.calibrate",
+    "Scene": "barhinge.scene",
+    "load_scene": "barhinge.scene",
+    "solve": "barhinge.solve.newton",
+    "tangent_stiffness": "barhinge.analysis.stiffness",
+    "gaussian_curvature": "barhinge.analysis.curvature",
+}
+
+__all__ = [
+    "Actuators",
+    "BarhingeError",
+    "ConfigError",
+    "ConvergenceError",
+    "CreasePattern",
+    "FoldPath",
+    "PatternError",
+    *_LAZY,
+]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        module = importlib.import_module(_LAZY[name])
+        value = module if name == "patterns" else getattr(module, name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'barhinge' has no attribute {name!r}")

@@ -1,0 +1,359 @@
+"""The crease pattern: vertices, creases with assignments and fold angles, faces.
+
+Conventions
+-----------
+* ``vertices`` are (n, 2) for a flat pattern or (n, 3) for any state (flat or folded).
+* ``assignment`` uses the FOLD letters: ``M`` mountain, ``V`` valley, ``F`` flat (facet line),
+  ``B`` boundary, ``U`` unassigned, ``C`` cut.
+* ``fold_angles`` are **degrees**, FOLD sign convention: 0 flat, valley > 0, mountain < 0,
+  ``|rho| <= 180``. They are the *target* fold angles (what the crease is meant to reach); the
+  fold angles of the current geometry are :meth:`CreasePattern.state_fold_angles`.
+* ``faces`` are vertex loops, counter-clockwise seen from +z in the flat state (the normal of
+  a face points to the side a valley fold closes towards).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+
+from barhinge._typing import ASSIGNMENTS
+from barhinge.errors import PatternError
+
+__all__ = ["CreasePattern"]
+
+
+def _readonly(a: np.ndarray) -> np.ndarray:
+    a.setflags(write=False)
+    return a
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class CreasePattern:
+    """A crease pattern (flat or folded state).
+
+    Parameters
+    ----------
+    vertices : (n, 2) or (n, 3) float
+        Vertex coordinates (length unit of the user's choice).
+    edges : (m, 2) int
+        Vertex indices of each edge.
+    assignment : (m,) str
+        One of ``M V F B U C`` per edge.
+    fold_angles : (m,) float, optional
+        Target fold angle per edge in degrees (valley > 0, mountain < 0). Defaults to 0.
+    faces : sequence of int sequences, optional
+        Counter-clockwise vertex loops. Derived from the planar graph when omitted.
+    developable : bool
+        Require sector angles to sum to 360 deg at flat interior vertices (set False for
+        non-developable families such as the egg-box).
+    meta : dict
+        Extra data (FOLD file metadata and unknown keys, kept for round trips).
+    validate : bool
+        Run :func:`barhinge.pattern.validate.check` on construction.
+    """
+
+    vertices: np.ndarray
+    edges: np.ndarray
+    assignment: np.ndarray
+    fold_angles: np.ndarray | None = None
+    faces: Sequence[Sequence[int]] | None = None
+    developable: bool = True
+    meta: dict[str, Any] = dataclasses.field(default_factory=dict)
+    validate: dataclasses.InitVar[bool] = True
+
+    def __post_init__(self, validate: bool) -> None:
+        V = np.array(self.vertices, dtype=float)
+        if V.ndim != 2 or V.shape[1] not in (2, 3):
+            raise PatternError(f"vertices must have shape (n, 2) or (n, 3), got {V.shape}")
+        if not np.all(np.isfinite(V)):
+            bad = int(np.flatnonzero(~np.all(np.isfinite(V), axis=1))[0])
+            raise PatternError(f"vertex {bad} has a non-finite coordinate: {V[bad].tolist()}")
+        E = np.asarray(self.edges)
+        if E.size == 0:
+            E = np.zeros((0, 2), dtype=np.int64)
+        if E.ndim != 2 or E.shape[1] != 2:
+            raise PatternError(f"edges must have shape (m, 2), got {E.shape}")
+        if not np.issubdtype(E.dtype, np.integer):
+            Ef = np.asarray(E, dtype=float)
+            if not np.all(Ef == np.round(Ef)):
+                raise PatternError("edges must hold integer vertex indices")
+            E = Ef.astype(np.int64)
+        E = E.astype(np.int64)
+        if E.size and (E.min() < 0 or E.max() >= len(V)):
+            bad = int(np.flatnonzero((E < 0).any(1) | (E >= len(V)).any(1))[0])
+            raise PatternError(
+                f"edge {bad} references vertex {E[bad].tolist()}, but there are {len(V)} vertices"
+            )
+        A = np.asarray(self.assignment if self.assignment is not None else ["U"] * len(E))
+        A = np.array([str(a).upper() for a in A.ravel()], dtype="<U1") if A.size else np.zeros(
+            0, dtype="<U1"
+        )
+        if len(A) != len(E):
+            raise PatternError(f"len(edges) = {len(E)}, but len(assignment) = {len(A)}")
+        unknown = ~np.isin(A, ASSIGNMENTS)
+        if unknown.any():
+            bad = int(np.flatnonzero(unknown)[0])
+            raise PatternError(
+                f"edge {bad} has assignment {A[bad]!r}; expected one of {' '.join(ASSIGNMENTS)}"
+            )
+        if self.fold_angles is None:
+            F = np.zeros(len(E))
+        else:
+            F = np.asarray(self.fold_angles, dtype=float).ravel()
+            if len(F) != len(E):
+                raise PatternError(f"len(edges) = {len(E)}, but len(fold_angles) = {len(F)}")
+            if not np.all(np.isfinite(F)):
+                bad = int(np.flatnonzero(~np.isfinite(F))[0])
+                raise PatternError(f"edge {bad} has a non-finite fold angle {F[bad]}")
+        faces = self.faces
+        if faces is None:
+            from barhinge.pattern.planar import planar_faces
+
+            faces = planar_faces(V[:, :2], E)
+        faces_t = tuple(tuple(int(i) for i in f) for f in faces)
+        for fi, f in enumerate(faces_t):
+            if len(f) < 3:
+                raise PatternError(f"face {fi} has {len(f)} vertices; expected at least 3")
+            if min(f) < 0 or max(f) >= len(V):
+                raise PatternError(f"face {fi} references a vertex outside 0..{len(V) - 1}")
+        object.__setattr__(self, "vertices", _readonly(V))
+        object.__setattr__(self, "edges", _readonly(E))
+        object.__setattr__(self, "assignment", _readonly(A))
+        object.__setattr__(self, "fold_angles", _readonly(F))
+        object.__setattr__(self, "faces", faces_t)
+        object.__setattr__(self, "meta", dict(self.meta))
+        if validate:
+            from barhinge.pattern.validate import check
+
+            check(self)
+
+    # ------------------------------------------------------------------ sizes
+    @property
+    def n_vertices(self) -> int:
+        return len(self.vertices)
+
+    @property
+    def n_edges(self) -> int:
+        return len(self.edges)
+
+    @property
+    def n_faces(self) -> int:
+        return len(self.faces)
+
+    @cached_property
+    def vertices3d(self) -> np.ndarray:
+        """(n, 3) float: vertex coordinates with z = 0 added to a 2-D pattern."""
+        V = self.vertices
+        if V.shape[1] == 3:
+            return V
+        return _readonly(np.column_stack([V, np.zeros(len(V))]))
+
+    @cached_property
+    def is_flat(self) -> bool:
+        """True if all vertices lie in the plane z = 0 (to 1e-9 of the pattern size)."""
+        V = self.vertices
+        if V.shape[1] == 2:
+            return True
+        return bool(np.all(np.abs(V[:, 2]) <= 1e-9 * max(self.size, 1e-300)))
+
+    @cached_property
+    def size(self) -> float:
+        """Diagonal of the bounding box (length unit)."""
+        if self.n_vertices == 0:
+            return 0.0
+        V = self.vertices
+        return float(np.linalg.norm(V.max(0) - V.min(0)))
+
+    # --------------------------------------------------------------- topology
+    @cached_property
+    def edge_index(self) -> dict[tuple[int, int], int]:
+        """Map from a sorted vertex pair to the edge id."""
+        return {(int(min(a, b)), int(max(a, b))): e for e, (a, b) in enumerate(self.edges)}
+
+    def edge_between(self, a: int, b: int) -> int:
+        """Edge id joining vertices a and b; PatternError if there is none."""
+        try:
+            return self.edge_index[(min(a, b), max(a, b))]
+        except KeyError:
+            raise PatternError(f"no edge joins vertices {a} and {b}") from None
+
+    @cached_property
+    def edge_faces(self) -> np.ndarray:
+        """(m, 2) int: face on the left of the directed edge ``edges[e,0] -> edges[e,1]``
+        (column 0) and on the right (column 1); -1 where there is none."""
+        EF = -np.ones((self.n_edges, 2), dtype=np.int64)
+        idx = self.edge_index
+        for fi, f in enumerate(self.faces):
+            for a, b in zip(f, f[1:] + f[:1], strict=True):
+                e = idx.get((min(a, b), max(a, b)))
+                if e is None:
+                    raise PatternError(f"face {fi} uses side ({a}, {b}), which is not an edge")
+                col = 0 if self.edges[e, 0] == a else 1
+                if EF[e, col] != -1:
+                    raise PatternError(
+                        f"edge {e} ({a}, {b}) is traversed in the same direction by faces "
+                        f"{EF[e, col]} and {fi}: non-manifold or inconsistent orientation"
+                    )
+                EF[e, col] = fi
+        return _readonly(EF)
+
+    @cached_property
+    def boundary_edges(self) -> np.ndarray:
+        """(k,) int: edges with fewer than two faces (or assigned B)."""
+        EF = self.edge_faces
+        return _readonly(np.flatnonzero((EF < 0).any(1) | (self.assignment == "B")))
+
+    @cached_property
+    def crease_edges(self) -> np.ndarray:
+        """(k,) int: interior edges that can fold (two faces, assignment M, V, F or U)."""
+        EF = self.edge_faces
+        ok = (EF >= 0).all(1) & np.isin(self.assignment, ("M", "V", "F", "U"))
+        return _readonly(np.flatnonzero(ok))
+
+    @cached_property
+    def boundary_vertices(self) -> np.ndarray:
+        """(k,) int: vertices on a boundary edge (outer boundary or a hole)."""
+        return _readonly(np.unique(self.edges[self.boundary_edges].ravel()))
+
+    @cached_property
+    def interior_vertices(self) -> np.ndarray:
+        """(k,) int: vertices with edges that are not on the boundary."""
+        used = np.zeros(self.n_vertices, bool)
+        used[self.edges.ravel()] = True
+        used[self.boundary_vertices] = False
+        return _readonly(np.flatnonzero(used))
+
+    @cached_property
+    def vertex_degree(self) -> np.ndarray:
+        """(n,) int: number of edges at each vertex."""
+        return _readonly(np.bincount(self.edges.ravel(), minlength=self.n_vertices))
+
+    @cached_property
+    def face_adjacency(self) -> np.ndarray:
+        """(k, 3) int rows ``(face_left, face_right, edge)`` for every edge shared by two
+        faces."""
+        EF = self.edge_faces
+        both = np.flatnonzero((EF >= 0).all(1))
+        return _readonly(np.column_stack([EF[both, 0], EF[both, 1], both]))
+
+    @cached_property
+    def vertex_corners(self) -> tuple[tuple[tuple[int, int], ...], ...]:
+        """Per vertex, the (face, position-in-loop) corners around it in counter-clockwise
+        order (a chain that may be open at boundary vertices)."""
+        n = self.n_vertices
+        at: list[dict[int, tuple[int, int]]] = [dict() for _ in range(n)]  # next-vertex -> corner
+        for fi, f in enumerate(self.faces):
+            k = len(f)
+            for p in range(k):
+                v, nxt = f[p], f[(p + 1) % k]
+                at[v][nxt] = (fi, p)
+        out: list[tuple[tuple[int, int], ...]] = []
+        for v in range(n):
+            corners = at[v]
+            if not corners:
+                out.append(())
+                continue
+            prev_of = {}
+            for nxt, (fi, p) in corners.items():
+                f = self.faces[fi]
+                prev_of[nxt] = f[(p - 1) % len(f)]
+            # start at a corner whose "next" edge is not the "prev" edge of any corner (open
+            # chain at the boundary); any corner for a closed fan.
+            prevs = set(prev_of.values())
+            starts = [nx for nx in corners if nx not in prevs]
+            start = starts[0] if starts else next(iter(corners))
+            chain, nx, seen = [], start, set()
+            while nx in corners and nx not in seen:
+                seen.add(nx)
+                chain.append(corners[nx])
+                nx = prev_of[nx]
+            if len(chain) != len(corners):  # more than one fan: non-manifold vertex
+                chain = [corners[k] for k in corners]
+            out.append(tuple(chain))
+        return tuple(out)
+
+    @cached_property
+    def face_corner_angles(self) -> tuple[np.ndarray, ...]:
+        """Per face, the interior angle (radians) at each corner of its loop, in the current
+        geometry."""
+        X = self.vertices3d
+        out = []
+        for f in self.faces:
+            P = X[list(f)]
+            u = np.roll(P, -1, axis=0) - P
+            w = np.roll(P, 1, axis=0) - P
+            c = np.einsum("ij,ij->i", u, w)
+            s = np.linalg.norm(np.cross(u, w), axis=1)
+            out.append(_readonly(np.arctan2(s, c)))
+        return tuple(out)
+
+    @cached_property
+    def sector_angles(self) -> tuple[np.ndarray, ...]:
+        """Per vertex, the sector angles (radians) of the faces around it, counter-clockwise."""
+        FA = self.face_corner_angles
+        return tuple(
+            _readonly(np.array([FA[fi][p] for fi, p in corners], dtype=float))
+            for corners in self.vertex_corners
+        )
+
+    @cached_property
+    def angle_defect(self) -> np.ndarray:
+        """(n,) float radians: 2*pi minus the sum of sector angles at interior vertices
+        (NaN at boundary or unused vertices)."""
+        d = np.full(self.n_vertices, np.nan)
+        for v in self.interior_vertices:
+            d[v] = 2 * np.pi - float(self.sector_angles[v].sum())
+        return _readonly(d)
+
+    @cached_property
+    def face_normals(self) -> np.ndarray:
+        """(n_faces, 3) unit normals (Newell's method), +z for a counter-clockwise flat face."""
+        X = self.vertices3d
+        N = np.zeros((self.n_faces, 3))
+        for fi, f in enumerate(self.faces):
+            P = X[list(f)]
+            Q = np.roll(P, -1, axis=0)
+            N[fi] = np.cross(P, Q).sum(0)
+        norm = np.linalg.norm(N, axis=1, keepdims=True)
+        return _readonly(N / np.where(norm > 0, norm, 1.0))
+
+    def state_fold_angles(self) -> np.ndarray:
+        """(m,) float degrees: fold angle of every edge in the current geometry.
+
+        Signed angle between the normals of the two faces of an edge, FOLD convention
+        (valley > 0). Edges with fewer than two faces get 0.
+        """
+        EF = self.edge_faces
+        both = (EF >= 0).all(1)
+        rho = np.zeros(self.n_edges)
+        if both.any():
+            N = self.face_normals
+            X = self.vertices3d
+            e = np.flatnonzero(both)
+            axis = X[self.edges[e, 1]] - X[self.edges[e, 0]]
+            axis /= np.linalg.norm(axis, axis=1, keepdims=True)
+            nl, nr = N[EF[e, 0]], N[EF[e, 1]]
+            s = np.einsum("ij,ij->i", np.cross(nr, nl), axis)
+            c = np.einsum("ij,ij->i", nl, nr)
+            rho[e] = np.degrees(np.arctan2(s, c))
+        return rho
+
+    # ------------------------------------------------------------ new objects
+    def replaced(self, **changes: Any) -> CreasePattern:
+        """A copy with some fields replaced (e.g. ``vertices=X`` for another state)."""
+        kw = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        kw.update(changes)
+        return CreasePattern(**kw)
+
+    def __repr__(self) -> str:
+        counts = {a: int((self.assignment == a).sum()) for a in ASSIGNMENTS}
+        asg = " ".join(f"{a}={c}" for a, c in counts.items() if c)
+        return (
+            f"CreasePattern(n_vertices={self.n_vertices}, n_edges={self.n_edges}, "
+            f"n_faces={self.n_faces}, {asg})"
+        )
