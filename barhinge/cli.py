@@ -54,15 +54,565 @@ def _json_default(o: object) -> object:
 
 # --- commands: info (foundation) ---
 
+
+def pattern_info(cp, findings_list) -> dict:
+    """Summary of a crease pattern for ``barhinge info`` (JSON-serialisable)."""
+    import numpy as np
+
+    from barhinge._typing import ASSIGNMENTS
+
+    V = cp.vertices
+    deg = cp.vertex_degree
+    values, counts = np.unique(deg, return_counts=True)
+    holes = [f for f in findings_list if f.code == "hole"]
+    return {
+        "n_vertices": cp.n_vertices,
+        "n_edges": cp.n_edges,
+        "edges_by_assignment": {a: int((cp.assignment == a).sum()) for a in ASSIGNMENTS},
+        "n_faces": cp.n_faces,
+        "n_interior_vertices": int(len(cp.interior_vertices)),
+        "n_boundary_vertices": int(len(cp.boundary_vertices)),
+        "degree_histogram": {int(v): int(c) for v, c in zip(values, counts, strict=True)},
+        "dimension": int(V.shape[1]),
+        "flat": bool(cp.is_flat),
+        "bounding_box": {
+            "min": V.min(0).tolist() if len(V) else [],
+            "max": V.max(0).tolist() if len(V) else [],
+        },
+        "size": cp.size,
+        "n_holes": len(holes),
+        "developable": cp.developable,
+        "findings": [f.as_dict() for f in findings_list],
+        "n_errors": sum(f.severity == "error" for f in findings_list),
+    }
+
+
+@app.command()
+def info(
+    file: Annotated[Path, typer.Argument(help="Crease pattern (.fold or .svg).")],
+    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+    developable: Annotated[
+        bool,
+        typer.Option(
+            "--developable/--non-developable",
+            help="Require sector angles to sum to 360 deg at interior vertices.",
+        ),
+    ] = True,
+    merge_tol: Annotated[
+        float | None,
+        typer.Option(help="Merge vertices closer than this length before checking."),
+    ] = None,
+) -> None:
+    """Counts, validation findings and bounding box of a crease pattern file.
+
+    Exit code 2 when the pattern has validation errors (they are listed).
+    """
+    from rich.table import Table
+
+    from barhinge.pattern.io import read
+    from barhinge.pattern.validate import findings
+
+    cp = read(file, validate=False)
+    if not developable:
+        cp = cp.replaced(developable=False, validate=False)
+    if merge_tol is not None:
+        cp = cp.replaced(merge_tol=merge_tol, validate=False)
+    found = findings(cp)
+    data = {"file": str(file), **pattern_info(cp, found)}
+    if as_json:
+        print_json(data)
+    else:
+        t = Table(title=f"{file.name}", show_header=False)
+        t.add_row("vertices", f"{data['n_vertices']} ({data['n_interior_vertices']} interior, "
+                  f"{data['n_boundary_vertices']} on the boundary)")  # fmt: skip
+        asg = " ".join(f"{a}={c}" for a, c in data["edges_by_assignment"].items() if c)
+        t.add_row("edges", f"{data['n_edges']} ({asg})")
+        t.add_row("faces", str(data["n_faces"]))
+        t.add_row("holes", str(data["n_holes"]))
+        hist = " ".join(f"{d}:{c}" for d, c in data["degree_histogram"].items())
+        t.add_row("vertex degrees", hist)
+        lo, hi = data["bounding_box"]["min"], data["bounding_box"]["max"]
+        fmt = lambda p: "(" + ", ".join(f"{x:.6g}" for x in p) + ")"  # noqa: E731
+        t.add_row("bounding box", f"{fmt(lo)} .. {fmt(hi)}")
+        t.add_row(
+            "state",
+            ("flat" if data["flat"] else "folded (3-D)") + f", {data['dimension']}-D coordinates",
+        )
+        console.print(t)
+        style = {"error": "bold red", "warning": "yellow", "info": "cyan"}
+        for f in found:
+            console.print(f"[{style[f.severity]}]{f.severity}[/] {f.code}: {f.message}",
+                          highlight=False, soft_wrap=True)  # fmt: skip
+        if not found:
+            console.print("[green]valid[/]: no findings")
+    if data["n_errors"]:
+        raise typer.Exit(2)
+
+
 # --- commands: patterns (pattern library) ---
+
+
+def _parse_param_value(text: str) -> object:
+    """A ``--param`` value: JSON (numbers, lists, true/false/null), a comma list of numbers,
+    or a plain string."""
+    try:
+        return json.loads(text)
+    except ValueError:
+        pass
+    if "," in text:
+        try:
+            return [float(x) for x in text.split(",")]
+        except ValueError:
+            pass
+    return text
+
+
+def _pattern_params(name: str, items: list[str]) -> dict[str, object]:
+    from barhinge.errors import PatternError
+    from barhinge.patterns import family_parameters
+
+    known = family_parameters(name)
+    out: dict[str, object] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise PatternError(f"--param {item!r}: expected NAME=VALUE")
+        if key not in known:
+            raise PatternError(
+                f"{name}: unknown parameter {key!r}; expected one of {', '.join(known)}"
+            )
+        out[key] = _parse_param_value(value.strip())
+    return out
+
+
+@app.command("patterns")
+def patterns_cmd(
+    name: Annotated[
+        str | None, typer.Argument(help="Family to generate; omit to list the families.")
+    ] = None,
+    param: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--param",
+            "-p",
+            help="Generator parameter NAME=VALUE (repeatable; lists as 1,2,3 or JSON).",
+        ),
+    ] = None,
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", help="Write the pattern to this FOLD file.")
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+) -> None:
+    """List the parametric pattern families, or generate one (``--out FILE.fold``)."""
+    import inspect
+
+    from rich.table import Table
+
+    from barhinge.patterns import (
+        FAMILIES,
+        FOLDABLE_FAMILIES,
+        family_parameters,
+        family_summary,
+    )
+
+    def shown(v: object) -> object:
+        return "(required)" if v is inspect.Parameter.empty else v
+
+    if name is None:
+        data = {
+            fam: {
+                "parameters": {k: shown(v) for k, v in family_parameters(fam).items()},
+                "exact_fold": fam in FOLDABLE_FAMILIES,
+                "summary": family_summary(fam),
+            }
+            for fam in FAMILIES
+        }
+        if as_json:
+            print_json(data)
+            return
+        t = Table(title="pattern families (barhinge patterns NAME --param k=v --out F.fold)")
+        t.add_column("family", style="bold")
+        t.add_column("parameters (defaults)")
+        t.add_column("fold=")
+        t.add_column("description")
+        for fam, d in data.items():
+            ps = ", ".join(f"{k}={v}" for k, v in d["parameters"].items())
+            t.add_row(fam, ps, "exact" if d["exact_fold"] else "", d["summary"])
+        console.print(t)
+        return
+    kwargs = _pattern_params(name, list(param or []))
+    try:
+        cp = FAMILIES[name](**kwargs)
+    except TypeError as exc:  # e.g. a list given where a number is expected
+        from barhinge.errors import PatternError
+
+        raise PatternError(f"{name}: bad parameter value ({exc})") from None
+    summary = {
+        "family": name,
+        "parameters": cp.meta.get("barhinge:parameters", {}),
+        "n_vertices": cp.n_vertices,
+        "n_edges": cp.n_edges,
+        "n_faces": cp.n_faces,
+        "n_interior_vertices": int(len(cp.interior_vertices)),
+        "edges_by_assignment": {
+            a: int((cp.assignment == a).sum())
+            for a in ("M", "V", "F", "B")
+            if (cp.assignment == a).any()
+        },
+        "folded": bool(not cp.is_flat),
+        "developable": bool(cp.developable),
+        "out": str(out) if out else None,
+    }
+    if out is not None:
+        from barhinge.pattern.fold import write_fold
+
+        write_fold(cp, out)
+    if as_json:
+        print_json(summary)
+        return
+    asg = " ".join(f"{a}={c}" for a, c in summary["edges_by_assignment"].items())
+    console.print(
+        f"{name}: {cp.n_vertices} vertices, {cp.n_edges} edges ({asg}), {cp.n_faces} faces"
+        + (f" -> {out}" if out else "  (use --out FILE.fold to write it)"),
+        highlight=False,
+    )
+
 
 # --- commands: dof (kinematics) ---
 
+
+def _dof_pattern(spec: str):
+    """A pattern from a file path (.fold/.svg) or a family spec ``name[:key=value,...]``
+    (e.g. ``miura:nx=4,ny=4,alpha=60``)."""
+    from barhinge.errors import ConfigError
+
+    if Path(spec).exists():
+        from barhinge.pattern.io import read
+
+        return read(spec)
+    from barhinge import patterns
+
+    name, _, args = spec.partition(":")
+    gen = patterns.FAMILIES.get(name)
+    if gen is None:
+        raise ConfigError(
+            f"{spec!r} is neither a file nor a pattern family; families: "
+            f"{', '.join(sorted(patterns.FAMILIES))}"
+        )
+    kw: dict[str, object] = {}
+    for item in filter(None, args.split(",")):
+        key, eq, val = item.partition("=")
+        if not eq:
+            raise ConfigError(f"family argument {item!r} must be key=value")
+        try:
+            kw[key.strip()] = json.loads(val)
+        except json.JSONDecodeError:
+            kw[key.strip()] = val
+    return gen(**kw)
+
+
+@app.command()
+def dof(
+    pattern: Annotated[
+        str, typer.Argument(help="Pattern file (.fold/.svg) or family spec, e.g. miura:nx=4,ny=4")
+    ],
+    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+    png: Annotated[Path | None, typer.Option("--png", help="Write the local-DOF picture.")] = None,
+    triangulated: Annotated[
+        bool, typer.Option("--triangulated", help="Let panels fold along diagonals.")
+    ] = False,
+    prefer: Annotated[
+        str | None,
+        typer.Option(help="Actuator preference: boundary, interior or spread."),
+    ] = None,
+) -> None:
+    """Rigid-origami DOF: global (count and rank), redundancy, local DOF and actuators."""
+    from barhinge.kinematics.dof import dof as compute_dof
+
+    cp = _dof_pattern(pattern)
+    rep = compute_dof(cp, triangulated=triangulated, prefer=prefer)
+    if png is not None:
+        from barhinge.plot.dof import draw_dof
+
+        draw_dof(cp, rep, png)
+    if as_json:
+        data = {"pattern": pattern, **rep.summary()}
+        if png is not None:
+            data["png"] = str(png)
+        print_json(data)
+        return
+    from rich.table import Table
+
+    t = Table(title=f"rigid DOF of {pattern}" + (" (triangulated)" if triangulated else ""))
+    t.add_column("")
+    t.add_column("this state")
+    reps = [rep] + ([rep.folded] if rep.folded is not None else [])
+    if rep.folded is not None:
+        t.add_column("folded state nearby")
+    t.add_row("flat", *[str(r.flat) for r in reps])
+    t.add_row("variables / equations",
+              *[f"{r.n_variables} / {r.n_equations}" for r in reps])  # fmt: skip
+    t.add_row("counted DOF (Tachi 2010)", *[str(r.counted_dof) for r in reps])
+    t.add_row("DOF from rank", *[f"{r.global_dof} (rank {r.rank}, {r.method})" for r in reps])
+    t.add_row("redundant constraints", *[str(r.redundant) for r in reps])
+
+    def hist(a) -> str:
+        import numpy as np
+
+        a = a[a >= 0]
+        v, c = np.unique(a, return_counts=True)
+        return ", ".join(f"{int(x)}: {int(n)}" for x, n in zip(v, c, strict=True)) or "-"
+
+    t.add_row("local DOF (value: vertices)", *[hist(r.local) for r in reps])
+    t.add_row("region DOF (value: vertices)", *[hist(r.region) for r in reps])
+    t.add_row("suggested actuators (edges)",
+              *[" ".join(map(str, r.actuators.tolist())) or "-" for r in reps])  # fmt: skip
+    console.print(t)
+    if rep.note:
+        console.print(f"note: {rep.note}", highlight=False)
+    if png is not None:
+        console.print(f"wrote {png}")
+
 # --- commands: fold (solver) ---
+
+
+@app.command("fold")
+def fold_cmd(
+    scene_file: Annotated[
+        Path | None, typer.Argument(help="Scene TOML; omitted: the built-in Miura scene.")
+    ] = None,
+    out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path("fold-out"),
+    as_json: Annotated[bool, typer.Option("--json", help="Print the summary as JSON.")] = False,
+) -> None:
+    """Fold a scene: solve it step by step, write the fold path and a summary."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+    from rich.table import Table
+
+    from barhinge.scene import default_scene, load_scene
+    from barhinge.solve.newton import solve
+    from barhinge.solve.outputs import summary, write_outputs
+
+    scene = default_scene() if scene_file is None else load_scene(scene_file)
+    bar = Progress(
+        TextColumn(f"[bold]{scene.name}[/]"),
+        BarColumn(),
+        TextColumn("step {task.completed}/{task.total}"),
+        TimeElapsedColumn(),
+        console=err_console,
+        disable=as_json,
+    )
+    with bar:
+        task = bar.add_task("fold", total=scene.steps)
+        try:
+            path = solve(scene, progress=lambda done, total, v: bar.update(task, completed=done))
+        except ConvergenceError as exc:
+            if exc.last_state is not None:
+                write_outputs(exc.last_state, scene, out)
+                err_console.print(f"partial results ({exc.last_state.n_states} states) in {out}")
+            raise
+    files = write_outputs(path, scene, out)
+    info = summary(path, scene)
+    from barhinge.plot import results_rows, results_summary
+
+    if as_json:
+        print_json({**info, "results": results_summary(out), "files": [str(f) for f in files]})
+        return
+    t = Table(title=f"fold: {scene.name}")
+    t.add_column("quantity")
+    t.add_column("value", justify="right")
+    t.add_row("DOF", str(info["n_dof"]))
+    t.add_row("states", str(info["n_states"]))
+    t.add_row("Newton iterations", str(info["newton_iterations"]))
+    t.add_row("wall time (s)", f"{info['wall_time_s']:.2f}")
+    for k, v in info["energy"].items():
+        t.add_row(f"energy {k}", f"{v:.6g}")
+    if info["actuators"]["moment"]:
+        m = [abs(float(v)) for v in info["actuators"]["moment"]]
+        t.add_row("max |actuator moment|", f"{max(m):.6g}")
+    for k, v in results_rows(out):
+        t.add_row(k, v)
+    t.add_row("output", str(out))
+    console.print(t)
+
 
 # --- commands: render (results) ---
 
+
+def _pattern_for(result: Path, pattern: Path | None):
+    """The crease pattern of a saved path: ``--pattern``, else a FOLD file beside it."""
+    from barhinge.errors import ConfigError
+
+    if pattern is not None:
+        from barhinge.pattern.io import read
+
+        return read(pattern)
+    stem = result.name.removesuffix(".npz")
+    for cand in (result.with_name(f"{stem}_pattern.fold"), result.with_name(f"{stem}.fold")):
+        if cand.is_file():
+            from barhinge.pattern.fold import read_fold
+
+            return read_fold(cand, validate=False)
+    raise ConfigError(
+        f"no crease pattern for {result.name}: expected {stem}_pattern.fold or {stem}.fold "
+        "beside it, or give --pattern FILE"
+    )
+
+
+@app.command()
+def render(
+    result: Annotated[Path, typer.Argument(help="Saved fold path (.npz from barhinge fold).")],
+    out: Annotated[
+        Path | None, typer.Option("--out", help="Output folder (default: beside RESULT).")
+    ] = None,
+    pattern: Annotated[
+        Path | None, typer.Option(help="Crease pattern file (default: the .fold beside RESULT).")
+    ] = None,
+    scalars: Annotated[
+        str, typer.Option(help="Array to colour by: fold_angle_deg, angle_defect, ...")
+    ] = "fold_angle_deg",
+    step: Annotated[int, typer.Option(help="State to render (default: the last).")] = -1,
+    gif: Annotated[bool, typer.Option("--gif/--no-gif", help="Also animate the path.")] = True,
+    backend: Annotated[str, typer.Option(help="auto, pyvista or matplotlib.")] = "auto",
+    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+) -> None:
+    """Re-render the pictures of a saved fold path (PNG of one state, charts, GIF)."""
+    from barhinge.errors import ConfigError
+    from barhinge.plot import charts
+    from barhinge.plot import render as rnd
+    from barhinge.results import FoldPath
+
+    if not result.is_file():
+        raise ConfigError(f"result file {result} does not exist")
+    fp = FoldPath.load(result)
+    cp = _pattern_for(result, pattern)
+    if fp.X.shape[1] < cp.n_vertices:
+        raise ConfigError(
+            f"the path has {fp.X.shape[1]} nodes, but the pattern has {cp.n_vertices} vertices"
+        )
+    n = fp.n_states
+    if not -n <= step < n:
+        raise ConfigError(f"--step {step} is outside the path's {n} states")
+    folder = out if out is not None else result.parent
+    folder.mkdir(parents=True, exist_ok=True)
+    stem = result.name.removesuffix(".npz")
+    s = step % n
+    X = fp.X[:, : cp.n_vertices]
+    written = {
+        "png": rnd.render_state(
+            X[s],
+            folder / f"{stem}_{scalars}_{s:04d}.png",
+            pattern=cp,
+            scalars=scalars,
+            fold_angles_deg=fp.fold_angles_deg[s],
+            title=f"state {s} of {n - 1}",
+            backend=backend,
+        )
+    }
+    written["charts"] = folder / f"{stem}_charts.png"
+    charts.summary_figure(fp, written["charts"])
+    if gif and n > 1:
+        fp_v = FoldPath(X=X, fold_angles_deg=fp.fold_angles_deg, kind=fp.kind)
+        written["gif"] = rnd.animate(
+            fp_v, folder / f"{stem}.gif", pattern=cp, scalars=scalars, backend=backend
+        )
+    if as_json:
+        print_json({k: str(v) for k, v in written.items()})
+    else:
+        for k, v in written.items():
+            console.print(f"[green]{k:>6}[/] {v}", highlight=False)
+
+
 # --- commands: study (sweeps) ---
+
+
+@app.command()
+def study(
+    study_file: Annotated[Path, typer.Argument(help="Study TOML (function, grid, points).")],
+    scheduler: Annotated[
+        str | None, typer.Option("--scheduler", help="Dask scheduler address, tcp://HOST:PORT.")
+    ] = None,
+    workers: Annotated[
+        int | None, typer.Option("--workers", help="Worker processes of the local cluster.")
+    ] = None,
+    serial: Annotated[bool, typer.Option("--serial", help="Run in this process.")] = False,
+    out: Annotated[Path | None, typer.Option("--out", help="Output folder.")] = None,
+    batch_size: Annotated[
+        int | None, typer.Option("--batch-size", help="Points per Dask task.")
+    ] = None,
+    retry_failed: Annotated[
+        bool, typer.Option("--retry-failed", help="Rerun points that failed before.")
+    ] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Print the counts as JSON.")] = False,
+) -> None:
+    """Run (or resume) a parameter study; finished points are skipped on a rerun."""
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    from barhinge.sweep import SweepReport, load_study, run_study
+
+    spec = load_study(study_file)
+    mode = "serial" if serial else ("dask" if scheduler else "local")
+    progress = Progress(
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("ok {task.fields[done]}  failed {task.fields[failed]}"),
+        TimeElapsedColumn(),
+        TextColumn("ETA"),
+        TimeRemainingColumn(),
+        console=err_console,
+        disable=as_json,
+    )
+    task = progress.add_task(spec.name, total=None, done=0, failed=0)
+
+    def on_start(rep: SweepReport) -> None:
+        progress.update(task, total=rep.pending, completed=0)
+
+    def on_record(rec: dict, rep: SweepReport) -> None:
+        progress.update(task, completed=rep.finished, done=rep.done, failed=rep.failed)
+
+    try:
+        with progress:
+            rep = run_study(
+                spec,
+                out=out,
+                mode=mode,
+                scheduler=scheduler,
+                workers=workers,
+                batch_size=batch_size,
+                retry_failed=retry_failed,
+                on_start=on_start,
+                on_record=on_record,
+            )
+    except KeyboardInterrupt:
+        err_console.print("interrupted; finished points are saved, rerun to resume")
+        sys.exit(130)
+    counts = {
+        "out": str(rep.out),
+        "total": rep.total,
+        "skipped": rep.skipped,
+        "done": rep.done,
+        "failed": rep.failed,
+        "elapsed_s": round(rep.elapsed_s, 3),
+    }
+    if as_json:
+        print_json(counts)
+        return
+    failed_all = sum(r.get("status") == "failed" for r in rep.records.values())
+    console.print(
+        f"{spec.name}: {rep.total} points, {rep.skipped} already done, {rep.done} ok and "
+        f"{rep.failed} failed now ({failed_all} failed in all), {rep.elapsed_s:.1f} s -> "
+        f"{rep.out / 'summary.csv'}",
+        highlight=False,
+    )
+
 
 # --- commands: verify ---
 

@@ -44,6 +44,10 @@ class FoldPath:
         Residual history of each step.
     wall_time : (n_states,) float
         Seconds spent to reach each state (cumulative from the start of the solve).
+    external_work : (n_states,) float
+        Work done on the structure by the loads, the support reactions (prescribed
+        displacements) and the actuators from state 0 (trapezoidal rule over every
+        increment); equals the stored energy change for an elastic structure. NaN if unknown.
     converged : bool
         False if the path stopped early; then ``message`` says why.
     kind : str
@@ -65,6 +69,7 @@ class FoldPath:
     iterations: np.ndarray | None = None
     residual_norms: tuple[tuple[float, ...], ...] = ()
     wall_time: np.ndarray | None = None
+    external_work: np.ndarray | None = None
     converged: bool = True
     message: str = ""
     kind: str = "bar-hinge"
@@ -89,6 +94,7 @@ class FoldPath:
             "load_factor": np.zeros(n),
             "iterations": np.zeros(n, np.int64),
             "wall_time": nan,
+            "external_work": nan,
         }
         for name, default in defaults.items():
             v = getattr(self, name)

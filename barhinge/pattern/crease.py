@@ -27,6 +27,14 @@ from barhinge.errors import PatternError
 __all__ = ["CreasePattern"]
 
 
+def _as_array(x: Any, dtype: Any, name: str) -> np.ndarray:
+    """np.array (a copy) that turns ragged or non-numeric input into a PatternError."""
+    try:
+        return np.array(x, dtype=dtype)
+    except (TypeError, ValueError, OverflowError):
+        raise PatternError(f"{name} must be a rectangular array of numbers") from None
+
+
 def _readonly(a: np.ndarray) -> np.ndarray:
     a.setflags(write=False)
     return a
@@ -55,6 +63,9 @@ class CreasePattern:
         Extra data (FOLD file metadata and unknown keys, kept for round trips).
     validate : bool
         Run :func:`barhinge.pattern.validate.check` on construction.
+    merge_tol : float, optional
+        Repair on construction: merge vertices closer than this length, drop zero-length and
+        duplicate edges (see :func:`barhinge.pattern.validate.merged_arrays`).
     """
 
     vertices: np.ndarray
@@ -65,21 +76,22 @@ class CreasePattern:
     developable: bool = True
     meta: dict[str, Any] = dataclasses.field(default_factory=dict)
     validate: dataclasses.InitVar[bool] = True
+    merge_tol: dataclasses.InitVar[float | None] = None
 
-    def __post_init__(self, validate: bool) -> None:
-        V = np.array(self.vertices, dtype=float)
+    def __post_init__(self, validate: bool, merge_tol: float | None = None) -> None:
+        V = _as_array(self.vertices, float, "vertices")
         if V.ndim != 2 or V.shape[1] not in (2, 3):
             raise PatternError(f"vertices must have shape (n, 2) or (n, 3), got {V.shape}")
         if not np.all(np.isfinite(V)):
             bad = int(np.flatnonzero(~np.all(np.isfinite(V), axis=1))[0])
             raise PatternError(f"vertex {bad} has a non-finite coordinate: {V[bad].tolist()}")
-        E = np.asarray(self.edges)
+        E = _as_array(self.edges, None, "edges")
         if E.size == 0:
             E = np.zeros((0, 2), dtype=np.int64)
         if E.ndim != 2 or E.shape[1] != 2:
             raise PatternError(f"edges must have shape (m, 2), got {E.shape}")
         if not np.issubdtype(E.dtype, np.integer):
-            Ef = np.asarray(E, dtype=float)
+            Ef = _as_array(E, float, "edges")
             if not np.all(Ef == np.round(Ef)):
                 raise PatternError("edges must hold integer vertex indices")
             E = Ef.astype(np.int64)
@@ -89,10 +101,16 @@ class CreasePattern:
             raise PatternError(
                 f"edge {bad} references vertex {E[bad].tolist()}, but there are {len(V)} vertices"
             )
-        A = np.asarray(self.assignment if self.assignment is not None else ["U"] * len(E))
-        A = np.array([str(a).upper() for a in A.ravel()], dtype="<U1") if A.size else np.zeros(
-            0, dtype="<U1"
+        A = _as_array(
+            self.assignment if self.assignment is not None else ["U"] * len(E), None, "assignment"
         )
+        A_list = [str(a).upper() for a in A.ravel()]
+        for i, a in enumerate(A_list):
+            if a not in ASSIGNMENTS:
+                raise PatternError(
+                    f"edge {i} has assignment {a!r}; expected one of {' '.join(ASSIGNMENTS)}"
+                )
+        A = np.array(A_list, dtype="<U1") if A_list else np.zeros(0, dtype="<U1")
         if len(A) != len(E):
             raise PatternError(f"len(edges) = {len(E)}, but len(assignment) = {len(A)}")
         unknown = ~np.isin(A, ASSIGNMENTS)
@@ -104,18 +122,25 @@ class CreasePattern:
         if self.fold_angles is None:
             F = np.zeros(len(E))
         else:
-            F = np.asarray(self.fold_angles, dtype=float).ravel()
+            F = _as_array(self.fold_angles, float, "fold_angles").ravel()
             if len(F) != len(E):
                 raise PatternError(f"len(edges) = {len(E)}, but len(fold_angles) = {len(F)}")
             if not np.all(np.isfinite(F)):
                 bad = int(np.flatnonzero(~np.isfinite(F))[0])
                 raise PatternError(f"edge {bad} has a non-finite fold angle {F[bad]}")
         faces = self.faces
+        if merge_tol is not None:
+            from barhinge.pattern.validate import merged_arrays
+
+            V, E, A, F, faces = merged_arrays(V, E, A, F, faces, merge_tol)
         if faces is None:
             from barhinge.pattern.planar import planar_faces
 
-            faces = planar_faces(V[:, :2], E)
-        faces_t = tuple(tuple(int(i) for i in f) for f in faces)
+            faces = planar_faces(V, E)
+        try:
+            faces_t = tuple(tuple(int(i) for i in f) for f in faces)
+        except (TypeError, ValueError, OverflowError):
+            raise PatternError("faces must be a sequence of vertex-index sequences") from None
         for fi, f in enumerate(faces_t):
             if len(f) < 3:
                 raise PatternError(f"face {fi} has {len(f)} vertices; expected at least 3")

@@ -1,0 +1,336 @@
+"""Vectorised element geometry: bar lengths and strains, hinge fold angles, with exact
+first and second derivatives.
+
+Conventions
+-----------
+* ``X`` : (n_nodes, 3) float coordinates.
+* ``bars`` : (n_bars, 2) int node pairs ``(a, b)``.
+* ``hinges`` : (n_hinges, 4) int ``(i, j, k, l)``: axis ``i -> j``, wing ``k`` on the left of
+  the axis and wing ``l`` on the right (seen from the side the face normals point to).
+  The left face is ``(i, j, k)`` and the right face ``(j, i, l)``, both counter-clockwise;
+  their normals are ``n_L = a x u`` and ``n_R = w x a`` with ``a = x_j - x_i``,
+  ``u = x_k - x_i``, ``w = x_l - x_i``.
+* Fold angle ``rho`` in radians, FOLD convention: 0 flat, valley > 0 (the wings rotate
+  towards the side their normals point to), mountain < 0, ``rho in (-pi, pi]``. It is the
+  signed angle from ``n_L`` to ``n_R`` about the axis, computed as
+  ``atan2(((n_R x n_L) . a) / |a|, n_L . n_R)``, which is accurate at every angle
+  (no ``arccos``), in particular near flat and near fully folded. This is the same definition
+  as :meth:`barhinge.pattern.crease.CreasePattern.state_fold_angles`.
+
+Derivatives
+-----------
+The gradient is the classical one for a dihedral angle (Bridson et al. 2003; Liu & Paulino
+2017, Proc. R. Soc. A 473:20170348, Eqs. 8-9; Filipov et al. 2017, IJSS, appendix), written
+in this module's node order::
+
+    d rho / d x_k =  |a| n_L / |n_L|^2
+    d rho / d x_l =  |a| n_R / |n_R|^2
+    d rho / d x_i = -(1 - t_k) g_k - (1 - t_l) g_l
+    d rho / d x_j = -t_k g_k - t_l g_l,   t_k = (u . a) / |a|^2,  t_l = (w . a) / |a|^2
+
+The Hessian is obtained here by exact differentiation of these expressions (chain rule on
+``n_L``, ``n_R``, ``|a|``, ``t_k``, ``t_l``); :mod:`barhinge.kernels.reference` implements
+Liu & Paulino's closed-form Hessian (their Eq. 10-13) independently, and the tests compare the
+two and both against finite differences.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from barhinge._typing import StrainMeasure
+
+__all__ = [
+    "bar_lengths",
+    "bar_strain",
+    "bar_strain_derivatives",
+    "hinge_angle",
+    "hinge_angle_gradient",
+    "hinge_angle_derivatives",
+    "hinge_angle_hessian_packed",
+    "hinge_energy_hessian_packed",
+]
+
+
+# ---------------------------------------------------------------------------------- bars
+def bar_lengths(X: np.ndarray, bars: np.ndarray) -> np.ndarray:
+    """(n_bars,) current lengths ``|x_b - x_a|``."""
+    d = X[bars[:, 1]] - X[bars[:, 0]]
+    return np.sqrt(np.einsum("ni,ni->n", d, d))
+
+
+def bar_strain(
+    X: np.ndarray, bars: np.ndarray, L0: np.ndarray, measure: StrainMeasure = "green"
+) -> np.ndarray:
+    """(n_bars,) axial strain: Green-Lagrange ``(L^2 - L0^2) / (2 L0^2)`` or engineering
+    ``(L - L0) / L0``."""
+    d = X[bars[:, 1]] - X[bars[:, 0]]
+    LL = np.einsum("ni,ni->n", d, d)
+    if measure == "green":
+        return 0.5 * (LL - L0 * L0) / (L0 * L0)
+    return (np.sqrt(LL) - L0) / L0
+
+
+def bar_strain_derivatives(
+    X: np.ndarray, bars: np.ndarray, L0: np.ndarray, measure: StrainMeasure = "green"
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Strain of every bar with its exact derivatives.
+
+    Returns
+    -------
+    eps : (n_bars,) strain.
+    d : (n_bars, 3) ``d eps / d x_b`` (``d eps / d x_a = -d``).
+    B : (n_bars, 3, 3) ``d^2 eps / d x_b^2``; the full 6x6 Hessian w.r.t. ``(x_a, x_b)`` is
+        ``[[B, -B], [-B, B]]``.
+
+    Green-Lagrange: ``d = (x_b - x_a) / L0^2``, ``B = I / L0^2``. Engineering:
+    ``d = e / L0`` (``e`` the unit bar direction), ``B = (I - e e^T) / (L L0)``.
+    """
+    dx = X[bars[:, 1]] - X[bars[:, 0]]
+    LL = np.einsum("ni,ni->n", dx, dx)
+    n = len(bars)
+    eye = np.broadcast_to(np.eye(3), (n, 3, 3))
+    if measure == "green":
+        inv = 1.0 / (L0 * L0)
+        eps = 0.5 * (LL * inv - 1.0)
+        d = dx * inv[:, None]
+        B = eye * inv[:, None, None]
+        return eps, d, B
+    L = np.sqrt(LL)
+    e = dx / L[:, None]
+    eps = L / L0 - 1.0
+    d = e / L0[:, None]
+    B = (eye - e[:, :, None] * e[:, None, :]) / (L * L0)[:, None, None]
+    return eps, d, B
+
+
+# -------------------------------------------------------------------------------- hinges
+def _hinge_vectors(X: np.ndarray, hinges: np.ndarray):
+    xi, xj, xk, xl = (X[hinges[:, c]] for c in range(4))
+    a = xj - xi
+    u = xk - xi
+    w = xl - xi
+    nL = np.cross(a, u)
+    nR = np.cross(w, a)
+    return a, u, w, nL, nR
+
+
+def _angle(a: np.ndarray, nL: np.ndarray, nR: np.ndarray) -> np.ndarray:
+    la = np.sqrt(np.einsum("ni,ni->n", a, a))
+    s = np.einsum("ni,ni->n", np.cross(nR, nL), a) / la
+    c = np.einsum("ni,ni->n", nL, nR)
+    return np.arctan2(s, c)
+
+
+def hinge_angle(X: np.ndarray, hinges: np.ndarray) -> np.ndarray:
+    """(n_hinges,) fold angle ``rho`` in radians, FOLD convention (valley > 0), in
+    ``(-pi, pi]``."""
+    a, _, _, nL, nR = _hinge_vectors(X, hinges)
+    return _angle(a, nL, nR)
+
+
+def hinge_angle_gradient(X: np.ndarray, hinges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(rho (nh,), grad (nh, 12))``; grad w.r.t. ``(x_i, x_j, x_k, x_l)`` xyz-interleaved."""
+    a, u, w, nL, nR = _hinge_vectors(X, hinges)
+    rho = _angle(a, nL, nR)
+    gi, gj, gk, gl, *_ = _gradient_parts(a, u, w, nL, nR)
+    return rho, np.concatenate([gi, gj, gk, gl], axis=1)
+
+
+def _gradient_parts(a, u, w, nL, nR):
+    aa = np.einsum("ni,ni->n", a, a)
+    la = np.sqrt(aa)
+    mL = np.einsum("ni,ni->n", nL, nL)
+    mR = np.einsum("ni,ni->n", nR, nR)
+    fL = nL / mL[:, None]  # n_L / |n_L|^2
+    fR = nR / mR[:, None]
+    gk = la[:, None] * fL
+    gl = la[:, None] * fR
+    tk = np.einsum("ni,ni->n", u, a) / aa
+    tl = np.einsum("ni,ni->n", w, a) / aa
+    gi = -(1.0 - tk)[:, None] * gk - (1.0 - tl)[:, None] * gl
+    gj = -tk[:, None] * gk - tl[:, None] * gl
+    return gi, gj, gk, gl, aa, la, mL, mR, fL, fR, tk, tl
+
+
+def _cross_t(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Cross product of component-major (3, n) arrays."""
+    return np.stack(
+        [p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0]]
+    )
+
+
+# packed upper triangle of a 12x12 matrix from its 3x3 node blocks (bi <= bj):
+# for each of the 10 upper blocks, the packed positions and the entries (row-major in 3x3)
+TRIU12 = np.triu_indices(12)
+_BLOCKS = [(0, 0), (0, 1), (0, 2), (0, 3), (1, 1), (1, 2), (1, 3), (2, 2), (2, 3), (3, 3)]
+_PACK: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
+for _bi, _bj in _BLOCKS:
+    _sel = np.flatnonzero((TRIU12[0] // 3 == _bi) & (TRIU12[1] // 3 == _bj))
+    _PACK[(_bi, _bj)] = (_sel, (TRIU12[0][_sel] % 3) * 3 + TRIU12[1][_sel] % 3)
+
+
+def _hinge_hessian_packed_t(X: np.ndarray, hinges: np.ndarray, law=None, out=None):
+    """Component-major fast path: ``rho (nh,)``, ``grad (12, nh)`` and the packed upper
+    triangle of the Hessian ``(78, nh)`` (``TRIU12`` order). Hinges are on the last axis of
+    every array, so each operation is a contiguous vector operation.
+
+    Block form (derived from the gradient of the module docstring): with
+    ``f_L = n_L/|n_L|^2``, ``s_L = |a|/|n_L|^2`` (same for R) and, per column node c,
+    ``v^L_c`` the vector with ``d n_L / d x_c = [v^L_c]x`` (``u - a, -u, a, 0`` for
+    ``i, j, k, l``; for ``n_R``: ``a - w, w, 0, -a``),
+    ``d g_k / d x_c = f_L (x) p^L_c + s_L [v^L_c]x`` with
+    ``p^L_c = d|a|/dx_c - 2 |a| f_L x v^L_c``; the rows of ``i`` and ``j`` follow from
+    ``g_i = -(1 - t_k) g_k - (1 - t_l) g_l`` and ``g_j = -t_k g_k - t_l g_l``. Every 3x3 block
+    is therefore ``f_L (x) alpha + f_R (x) beta + [sigma]x``, filled row by row of the
+    packed triangle (vectors of length nh that stay in cache).
+
+    With ``law`` (a callable ``rho -> (M, dM/drho, W)``) the packed result is the Hessian of
+    the hinge energy, ``M d2rho + (dM/drho) grad grad^T``, and ``(M, dM/drho, W)`` are
+    returned too; without it, the Hessian of ``rho`` and ``(None, None, None)``.
+    """
+    XT = np.ascontiguousarray(X.T)
+    xi, xj, xk, xl = (XT[:, hinges[:, c]] for c in range(4))
+    a = xj - xi
+    u = xk - xi
+    w = xl - xi
+    nL = _cross_t(a, u)
+    nR = _cross_t(w, a)
+    aa = (a * a).sum(0)
+    la = np.sqrt(aa)
+    rho = np.arctan2((_cross_t(nR, nL) * a).sum(0) / la, (nL * nR).sum(0))
+    mL = (nL * nL).sum(0)
+    mR = (nR * nR).sum(0)
+    fL = nL / mL
+    fR = nR / mR
+    gk = la * fL
+    gl = la * fR
+    tk = (u * a).sum(0) / aa
+    tl = (w * a).sum(0) / aa
+    gi = -(1.0 - tk) * gk - (1.0 - tl) * gl
+    gj = -tk * gk - tl * gl
+    grad = np.concatenate([gi, gj, gk, gl], axis=0)  # (12, nh)
+
+    sL = la / mL
+    sR = la / mR
+    ahat = a / la
+    ia = a / aa
+    zero = np.zeros_like(a)
+    vL = (u - a, -u, a, None)
+    vR = (a - w, w, None, -a)
+    Dla = (-ahat, ahat, zero, zero)
+    Dtk = ((-a - u) / aa + 2.0 * tk * ia, u / aa - 2.0 * tk * ia, ia, zero)
+    Dtl = ((-a - w) / aa + 2.0 * tl * ia, w / aa - 2.0 * tl * ia, zero, ia)
+    twola = 2.0 * la
+    pL = [None if v is None else Dla[c] - twola * _cross_t(fL, v) for c, v in enumerate(vL)]
+    pR = [None if v is None else Dla[c] - twola * _cross_t(fR, v) for c, v in enumerate(vR)]
+
+    nh = len(hinges)
+    if law is None:
+        M = Kt = W = None
+        FL, FR, scale = fL, fR, 1.0
+    else:
+        M, Kt, W = law(rho)
+        FL, FR, scale = M * fL, M * fR, M
+        Ktg = Kt * grad
+    Hp = np.empty((78, nh)) if out is None else out
+    tmp = np.empty(nh)
+    skew_sign = {(0, 1): (2, -1.0), (0, 2): (1, 1.0), (1, 0): (2, 1.0), (1, 2): (0, -1.0),
+                 (2, 0): (1, -1.0), (2, 1): (0, 1.0)}
+
+    def put(bi: int, bj: int, alpha, beta, sigma) -> None:
+        pos, ent = _PACK[(bi, bj)]
+        if sigma is not None and law is not None:
+            sigma = scale * sigma
+        for p, e in zip(pos, ent, strict=True):
+            r, c = divmod(int(e), 3)
+            out = Hp[p]
+            if alpha is not None:
+                np.multiply(FL[r], alpha[c], out=out)
+            else:
+                out[...] = 0.0
+            if beta is not None:
+                np.multiply(FR[r], beta[c], out=tmp)
+                out += tmp
+            if sigma is not None and (r, c) in skew_sign:
+                comp, sgn = skew_sign[(r, c)]
+                if sgn > 0:
+                    out += sigma[comp]
+                else:
+                    out -= sigma[comp]
+            if law is not None:
+                np.multiply(Ktg[3 * bi + r], grad[3 * bj + c], out=tmp)
+                out += tmp
+
+    def sig(cL, cR, c):
+        out = None
+        if vL[c] is not None:
+            out = cL * sL * vL[c]
+        if vR[c] is not None:
+            t = cR * sR * vR[c]
+            out = t if out is None else out + t
+        return out
+
+    for c in range(4):  # row blocks of i (c >= 0) and j (c >= 1)
+        aL = la * Dtk[c] - ((1.0 - tk) * pL[c] if pL[c] is not None else 0.0)
+        aR = la * Dtl[c] - ((1.0 - tl) * pR[c] if pR[c] is not None else 0.0)
+        put(0, c, aL, aR, sig(-(1.0 - tk), -(1.0 - tl), c))
+        if c >= 1:
+            bL = -la * Dtk[c] - (tk * pL[c] if pL[c] is not None else 0.0)
+            bR = -la * Dtl[c] - (tl * pR[c] if pR[c] is not None else 0.0)
+            put(1, c, bL, bR, sig(-tk, -tl, c))
+    put(2, 2, pL[2], None, sL * a)
+    put(2, 3, None, None, None)
+    put(3, 3, None, pR[3], -sR * a)
+    return rho, grad, Hp, (M, Kt, W)
+
+
+def hinge_angle_derivatives(
+    X: np.ndarray, hinges: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Fold angle of every hinge with its exact gradient and Hessian.
+
+    Parameters
+    ----------
+    X : (n_nodes, 3) float
+    hinges : (nh, 4) int ``(i, j, k, l)``
+
+    Returns
+    -------
+    rho : (nh,) radians, FOLD convention (valley > 0).
+    grad : (nh, 12) ``d rho / d (x_i, x_j, x_k, x_l)``, xyz interleaved per node.
+    hess : (nh, 12, 12) symmetric second derivative, same ordering.
+    """
+    rho, grad, Hp, _ = _hinge_hessian_packed_t(X, hinges)
+    iu, ju = TRIU12
+    H = np.empty((len(hinges), 12, 12))
+    H[:, iu, ju] = Hp.T
+    H[:, ju, iu] = Hp.T
+    return rho, np.ascontiguousarray(grad.T), H
+
+
+def hinge_angle_hessian_packed(
+    X: np.ndarray, hinges: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Like :func:`hinge_angle_derivatives` but component-major (the assembly's fast path):
+    ``rho (nh,)``, ``grad (12, nh)`` and the packed upper triangle of the Hessian
+    ``(78, nh)`` in ``numpy.triu_indices(12)`` order."""
+    rho, grad, Hp, _ = _hinge_hessian_packed_t(X, hinges)
+    return rho, grad, Hp
+
+
+def hinge_energy_hessian_packed(X: np.ndarray, hinges: np.ndarray, law, out=None):
+    """Fast path of the assembly: hinge energy derivatives, component-major.
+
+    Parameters
+    ----------
+    law : callable ``rho (nh,) -> (M, dM/drho, W)``, each (nh,)
+    out : optional (78, nh) float array to write the packed Hessian into
+
+    Returns
+    -------
+    rho (nh,), M (nh,), Kt (nh,), W (nh,), grad of rho (12, nh), packed upper triangle of the
+    energy Hessian ``M d2rho/dX2 + Kt grad grad^T`` (78, nh) in ``TRIU12`` order.
+    """
+    rho, grad, Hp, (M, Kt, W) = _hinge_hessian_packed_t(X, hinges, law, out)
+    return rho, M, Kt, W, grad, Hp

@@ -1,0 +1,493 @@
+"""Degrees of freedom of rigid origami: counting, rank, redundancy, local DOF, actuators.
+
+* Counting estimate (Tachi 2010, "Geometric considerations for the design of rigid origami
+  structures", Proc. IASS): ``E_in - 3 V_in - sum_panels (n - 3)`` where ``E_in`` counts the
+  interior creases of the triangulated pattern and ``V_in`` the interior vertices; each n-gon
+  panel adds ``n - 3`` diagonals and ``n - 3`` planarity conditions, so the count equals
+  (creases) - 3 (interior vertices) in the angle formulation.
+* True (first-order) DOF: ``n_var - rank J`` with ``J`` the loop-closure Jacobian
+  (:mod:`barhinge.kinematics.constraints`) at the given state; the number of redundant
+  constraints is ``rank deficiency of the rows = DOF - count``. The flat state is special:
+  every crease axis lies in the plane, so each vertex block has rank 2, not 3, and the
+  first-order DOF exceeds the finite one (the flat state is a bifurcation point). The report
+  therefore also evaluates a folded state near the flat one (``report.folded``).
+* Local DOF of a vertex: ``degree - rank`` of its 3 x degree block (``degree - 3`` at a folded
+  generic vertex); of a region (the vertex and its neighbouring interior vertices):
+  ``(creases touching the region) - rank`` of the region's rows.
+* Actuators: creases whose fold angles determine the configuration to first order = columns
+  of the null-space basis ``N`` (n_var, dof) with ``N[A, :]`` invertible and well conditioned,
+  chosen by column-pivoted QR of ``(N * w).T`` (Businger & Golub 1965), with weights ``w``
+  that steer the choice.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from barhinge.errors import ConfigError, PatternError
+from barhinge.kinematics.constraints import RigidConstraints
+from barhinge.kinematics.linalg import DENSE_LIMIT, NullSpace, null_space
+from barhinge.pattern.crease import CreasePattern
+
+__all__ = ["DofReport", "dof", "select_actuators", "folded_sample"]
+
+log = logging.getLogger(__name__)
+
+#: a state whose largest |fold angle| is below this (rad) is reported as flat
+FLAT_TOL = 1e-6
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class DofReport:
+    """Degrees of freedom of a rigid-origami pattern at one state.
+
+    Attributes
+    ----------
+    global_dof : int
+        First-order DOF ``n_variables - rank`` at this state.
+    counted_dof : int
+        Tachi (2010) count ``E_in - 3 V_in - sum(n - 3)``.
+    redundant : int
+        Redundant constraints ``global_dof - counted_dof`` (= n_equations - rank).
+    rank : int
+        Numerical rank of the loop-closure Jacobian.
+    tolerance : float
+        Absolute singular-value threshold used for the rank.
+    method : str
+        ``"svd"`` (dense) or ``"sparse-eigsh"``.
+    n_variables, n_equations, n_interior_vertices : int
+    flat : bool
+        True when the state is flat (first-order DOF overestimates the finite DOF).
+    local : (n_vertices,) int
+        Local DOF of each constrained interior vertex (-1 elsewhere).
+    region : (n_vertices,) int
+        DOF of the region made of each vertex and its neighbouring interior vertices (-1 at
+        unconstrained vertices).
+    actuators : (k,) int
+        Pattern edge ids whose fold angles determine the configuration (first order).
+    triangulated : bool
+    closure : float
+        Largest loop-closure error ``|F - I|`` of the state (0 for an exact rigid state).
+    folded : DofReport or None
+        For a flat state: the same analysis at a rigidly folded state nearby (None if none was
+        found, see ``note``).
+    note : str
+    fold_angles_deg : (n_edges,) float
+        Fold angles of the analysed state per pattern edge.
+    """
+
+    global_dof: int
+    counted_dof: int
+    redundant: int
+    rank: int
+    tolerance: float
+    method: str
+    n_variables: int
+    n_equations: int
+    n_interior_vertices: int
+    flat: bool
+    local: np.ndarray
+    region: np.ndarray
+    actuators: np.ndarray
+    triangulated: bool
+    closure: float
+    folded: DofReport | None = None
+    note: str = ""
+    fold_angles_deg: np.ndarray | None = None
+
+    @property
+    def mechanism(self) -> DofReport:
+        """The report that describes the finite mechanism: ``folded`` for a flat state (when
+        found), else this one."""
+        return self.folded if (self.flat and self.folded is not None) else self
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-serialisable summary (what ``barhinge dof --json`` prints)."""
+
+        def one(r: DofReport) -> dict[str, Any]:
+            loc = r.local[r.local >= 0]
+            reg = r.region[r.region >= 0]
+            return {
+                "global_dof": r.global_dof,
+                "counted_dof": r.counted_dof,
+                "redundant": r.redundant,
+                "rank": r.rank,
+                "tolerance": r.tolerance,
+                "method": r.method,
+                "n_variables": r.n_variables,
+                "n_equations": r.n_equations,
+                "n_interior_vertices": r.n_interior_vertices,
+                "flat": r.flat,
+                "closure": r.closure,
+                "local_dof_histogram": {int(k): int(v) for k, v in zip(*np.unique(loc, return_counts=True), strict=True)},
+                "region_dof_histogram": {int(k): int(v) for k, v in zip(*np.unique(reg, return_counts=True), strict=True)},
+                "actuators": r.actuators.tolist(),
+                "note": r.note,
+            }
+
+        out = {"triangulated": self.triangulated, "state": one(self)}
+        if self.folded is not None:
+            out["folded_state"] = one(self.folded)
+        return out
+
+
+# ------------------------------------------------------------------------- public API
+def dof(
+    cp: CreasePattern,
+    state: np.ndarray | Sequence[float] | None = None,
+    *,
+    triangulated: bool = False,
+    prefer: str | Sequence[int] | None = None,
+    tol: float | None = None,
+    folded_check: bool = True,
+) -> DofReport:
+    """Global and local degrees of freedom of ``cp`` as a rigid origami.
+
+    Parameters
+    ----------
+    cp : CreasePattern
+        The pattern; its geometry is the reference state (flat or folded).
+    state : None, (n_edges,) float or (n_vertices, 3) float
+        The state to analyse: None = the pattern's own geometry; fold angles in degrees per
+        pattern edge (valley > 0); or vertex coordinates.
+    triangulated : bool
+        Split non-triangular panels by diagonals that may fold (else panels are rigid).
+    prefer : None, "boundary", "interior", "spread" or sequence of edge ids
+        Steers the actuator choice: creases near the boundary, near the centre, spread out
+        (neighbours of a chosen crease are penalised), or inside a given region (edge ids).
+    tol : float, optional
+        Relative singular-value threshold for the rank (default 1e-8 dense SVD, 1e-6 sparse).
+    folded_check : bool
+        At a flat state, also analyse a folded state nearby (``report.folded``).
+
+    Returns
+    -------
+    DofReport
+    """
+    if state is not None:
+        s = np.asarray(state, dtype=float)
+        if s.ndim == 2 and s.shape == (cp.n_vertices, 3):
+            cp = cp.replaced(vertices=s, validate=False)
+            state = None
+    rc = RigidConstraints.from_pattern(cp, triangulated=triangulated)
+    rho = _state_angles(rc, state)
+    rep = _report(rc, rho, prefer=prefer, tol=tol)
+    if rep.flat and folded_check and rc.n_var > 0:
+        try:
+            rho_f = folded_sample(rc)
+        except PatternError as exc:
+            return dataclasses.replace(rep, note=_join(rep.note, str(exc)))
+        folded = _report(rc, rho_f, prefer=prefer, tol=tol)
+        rep = dataclasses.replace(
+            rep,
+            folded=folded,
+            note=_join(
+                rep.note,
+                f"flat state: first-order DOF {rep.global_dof} overestimates the finite DOF; "
+                f"at a folded state nearby the DOF is {folded.global_dof}",
+            ),
+        )
+    return rep
+
+
+def _join(a: str, b: str) -> str:
+    return f"{a}; {b}" if a else b
+
+
+def _state_angles(rc: RigidConstraints, state: Any) -> np.ndarray:
+    """(n_var,) radians from a state given per pattern edge in degrees (None: reference)."""
+    if state is None:
+        return rc.rho0.copy()
+    s = np.asarray(state, dtype=float).ravel()
+    if len(s) != rc.source.n_edges:
+        raise ConfigError(
+            f"state must be fold angles per edge ({rc.source.n_edges},) or coordinates "
+            f"({rc.source.n_vertices}, 3); got shape {np.shape(state)}"
+        )
+    rho = np.zeros(rc.n_var)
+    vs = rc.var_source_edge
+    rho[vs >= 0] = np.radians(s[vs[vs >= 0]])
+    return rho
+
+
+def _report(
+    rc: RigidConstraints, rho: np.ndarray, *, prefer: Any, tol: float | None
+) -> DofReport:
+    r, J = rc.evaluate(rho)
+    ns = null_space(J, tol)
+    n_faces_extra = 0 if rc.triangulated else sum(len(f) - 3 for f in rc.pattern.faces)
+    e_in_tri = rc.n_var + n_faces_extra
+    counted = e_in_tri - 3 * len(rc.vertices) - n_faces_extra
+    g = rc.n_var - ns.rank
+    closure = float(rc.closure_error(rho).max()) if len(rc.vertices) else 0.0
+    flat = bool(np.max(np.abs(rho), initial=0.0) < FLAT_TOL)
+    local, region = local_dof(rc, rho, tol=tol)
+    acts = select_actuators(rc, ns, prefer=prefer)
+    note = ""
+    if closure > 1e-8:
+        note = (
+            f"the state does not close (max |F - I| = {closure:.2e}): the rank is that of the "
+            "linearisation at a non-rigid state"
+        )
+    if len(acts) < g:
+        note = _join(
+            note,
+            f"only {len(acts)} of {g} DOF can be driven by pattern creases "
+            "(the others move panel diagonals)",
+        )
+    return DofReport(
+        global_dof=g,
+        counted_dof=int(counted),
+        redundant=int(g - counted),
+        rank=ns.rank,
+        tolerance=ns.tolerance,
+        method=ns.method,
+        n_variables=rc.n_var,
+        n_equations=rc.n_eq,
+        n_interior_vertices=len(rc.vertices),
+        flat=flat,
+        local=local,
+        region=region,
+        actuators=acts,
+        triangulated=rc.triangulated,
+        closure=closure,
+        note=note,
+        fold_angles_deg=rc.angles_of_edges(rho),
+    )
+
+
+# ------------------------------------------------------------------------- local DOF
+def _vertex_blocks(rc: RigidConstraints, rho: np.ndarray) -> np.ndarray:
+    """(n_cv, 3, D) dense Jacobian block of each vertex (zero columns at padding)."""
+    F, A = rc.loop_products(rho)
+    tr = np.trace(F, axis1=1, axis2=2)
+    G = 0.5 * (tr[:, None, None] * np.eye(3) - F)
+    B = np.einsum("vij,vdj->vid", G, A)
+    B[np.broadcast_to((rc.loop_var < 0)[:, None, :], B.shape)] = 0.0
+    return B
+
+
+def local_dof(
+    rc: RigidConstraints, rho: np.ndarray, *, tol: float | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Local DOF per vertex and per one-ring region.
+
+    Returns
+    -------
+    local : (n_vertices,) int
+        ``degree - rank(block)`` at constrained vertices, -1 elsewhere.
+    region : (n_vertices,) int
+        ``(creases touching the region) - rank(rows of the region)`` for the region made of
+        the vertex and its neighbouring constrained vertices, -1 elsewhere.
+    """
+    n = rc.pattern.n_vertices
+    local = -np.ones(n, dtype=np.int64)
+    region = -np.ones(n, dtype=np.int64)
+    nv = len(rc.vertices)
+    if nv == 0:
+        return local, region
+    rel = 1e-8 if tol is None else tol
+    B = _vertex_blocks(rc, rho)
+    deg = (rc.loop_var >= 0).sum(1)
+    s = np.linalg.svd(B, compute_uv=False)  # (nv, min(3, D))
+    rank_v = (s > rel * np.maximum(s.max(1, keepdims=True), 1e-300)).sum(1)
+    local[rc.vertices] = deg - rank_v
+    # regions: vertex + neighbours sharing a crease
+    owner = -np.ones(rc.n_var * 2, dtype=np.int64).reshape(rc.n_var, 2)
+    cnt = np.zeros(rc.n_var, dtype=np.int64)
+    for i, lv in enumerate(rc.loop_var):
+        for k in lv[lv >= 0]:
+            owner[k, cnt[k]] = i
+            cnt[k] += 1
+    members = []
+    for i, lv in enumerate(rc.loop_var):
+        nb = owner[lv[lv >= 0]].ravel()
+        members.append(np.unique(np.concatenate([[i], nb[nb >= 0]])))
+    rmax = max(len(m) for m in members)
+    D = rc.loop_var.shape[1]
+    cmax = rmax * D
+    M = np.zeros((nv, 3 * rmax, cmax))
+    nvar = np.zeros(nv, dtype=np.int64)
+    for i, mem in enumerate(members):
+        vars_ = np.unique(rc.loop_var[mem][rc.loop_var[mem] >= 0])
+        pos = {int(k): c for c, k in enumerate(vars_)}
+        nvar[i] = len(vars_)
+        for r, w in enumerate(mem):
+            lv = rc.loop_var[w]
+            for d in np.flatnonzero(lv >= 0):
+                M[i, 3 * r : 3 * r + 3, pos[int(lv[d])]] = B[w, :, d]
+    s = np.linalg.svd(M, compute_uv=False)
+    rank_r = (s > rel * np.maximum(s.max(1, keepdims=True), 1e-300)).sum(1)
+    region[rc.vertices] = nvar - rank_r
+    return local, region
+
+
+# ------------------------------------------------------------------------- actuators
+def _edge_hops_to_boundary(cp: CreasePattern) -> np.ndarray:
+    """(n_edges,) int: graph distance (in vertices) from each edge to the boundary."""
+    n = cp.n_vertices
+    E = cp.edges
+    A = sp.coo_matrix((np.ones(2 * len(E)), (E.ravel(), E[:, ::-1].ravel())), shape=(n, n)).tocsr()
+    dist = np.full(n, np.iinfo(np.int64).max)
+    front = np.zeros(n, bool)
+    front[cp.boundary_vertices] = True
+    d = 0
+    seen = front.copy()
+    while front.any():
+        dist[front] = d
+        nxt = (A @ front.astype(float)) > 0
+        front = nxt & ~seen
+        seen |= front
+        d += 1
+    dist[dist == np.iinfo(np.int64).max] = d
+    return np.minimum(dist[E[:, 0]], dist[E[:, 1]])
+
+
+def select_actuators(
+    rc: RigidConstraints, ns: NullSpace, *, prefer: str | Sequence[int] | None = None
+) -> np.ndarray:
+    """Pattern edge ids of creases whose fold angles determine the configuration.
+
+    Column-pivoted QR of the weighted null-space basis ``(N * w).T``: the k pivots have an
+    invertible, well conditioned ``N[A, :]``, so fixing their increments fixes the whole first
+    order motion. Panel diagonals (triangulated mode) are never chosen.
+
+    Parameters
+    ----------
+    prefer : None, "boundary", "interior", "spread" or sequence of edge ids
+        See :func:`dof`.
+    """
+    N = ns.basis
+    k = N.shape[1]
+    if k == 0:
+        return np.zeros(0, dtype=np.int64)
+    src = rc.var_source_edge
+    w = np.ones(rc.n_var)
+    spread = False
+    if prefer is None:
+        pass
+    elif isinstance(prefer, str):
+        if prefer not in ("boundary", "interior", "spread"):
+            raise ConfigError(
+                f"prefer = {prefer!r}; expected 'boundary', 'interior', 'spread' or edge ids"
+            )
+        if prefer == "spread":
+            spread = True
+        else:
+            hops = _edge_hops_to_boundary(rc.source)[np.maximum(src, 0)].astype(float)
+            w = 0.5**hops if prefer == "boundary" else 0.5 ** (hops.max() - hops)
+    else:
+        ids = np.asarray(list(prefer), dtype=np.int64)
+        if ids.size and (ids.min() < 0 or ids.max() >= rc.source.n_edges):
+            raise ConfigError(
+                f"prefer lists edge ids outside 0..{rc.source.n_edges - 1}: {ids.tolist()[:5]}"
+            )
+        w = np.full(rc.n_var, 1e-3)
+        v = rc.var_of_source_edge[ids]
+        w[v[v >= 0]] = 1.0
+    w = np.where(src >= 0, w, 0.0)
+    W = (N * w[:, None]).T  # (k, n_var)
+    if spread:
+        piv = _greedy_spread(rc, W)
+    else:
+        _, R, P = sla.qr(W, mode="economic", pivoting=True)
+        d = np.abs(np.diag(R))
+        good = d > 1e-8 * max(d[0], 1e-300) if len(d) else np.zeros(0, bool)
+        piv = P[: int(good.sum())]
+    return np.sort(src[piv]).astype(np.int64)
+
+
+def _greedy_spread(rc: RigidConstraints, W: np.ndarray) -> np.ndarray:
+    """Pivoted Gram-Schmidt on the columns of W (k, n) that damps the neighbours (creases
+    sharing a vertex) of every chosen crease by 0.1, spreading the actuators out."""
+    k, n = W.shape
+    E = rc.pattern.edges[rc.crease_edge]
+    inc = sp.coo_matrix(
+        (np.ones(2 * n), (np.repeat(np.arange(n), 2), E.ravel())), shape=(n, rc.pattern.n_vertices)
+    ).tocsr()
+    nbr = (inc @ inc.T).tocsr()
+    R = W.copy()
+    damp = np.ones(n)
+    norms0 = np.linalg.norm(W, axis=0)
+    ref = norms0.max() if n else 1.0
+    chosen: list[int] = []
+    for _ in range(k):
+        norms = np.linalg.norm(R, axis=0)
+        score = norms * damp
+        j = int(np.argmax(score))
+        if norms[j] <= 1e-8 * ref:
+            break
+        chosen.append(j)
+        q = R[:, j] / norms[j]
+        R -= np.outer(q, q @ R)
+        damp[nbr[j].indices] *= 0.1
+    return np.asarray(chosen, dtype=np.int64)
+
+
+# ------------------------------------------------------------------------- folded sample
+def _branch_direction(rc: RigidConstraints) -> np.ndarray:
+    """(n_var,) direction to leave the flat state: the pattern's target fold angles where
+    given, else the assignment signs (V +1, M -1)."""
+    src = rc.var_source_edge
+    tgt = np.zeros(rc.n_var)
+    ok = src >= 0
+    tgt[ok] = np.radians(rc.source.fold_angles[src[ok]])
+    if np.any(tgt != 0.0):
+        return tgt
+    asg = np.where(ok, rc.source.assignment[np.maximum(src, 0)], "F")
+    return np.where(asg == "V", 1.0, np.where(asg == "M", -1.0, 0.0))
+
+
+def folded_sample(rc: RigidConstraints, *, magnitude: float = 0.3, max_iter: int = 50) -> np.ndarray:
+    """A rigidly folded state near the flat one.
+
+    The branch direction (target angles, else M/V signs) is scaled to ``magnitude`` rad; the
+    crease with the largest component is held there and the others are projected onto the
+    constraints by minimum-norm Gauss-Newton (holding one crease keeps the projection from
+    collapsing onto the flat apex of the configuration cone). Raises PatternError if no
+    folded state is found (e.g. a pattern that is not rigidly foldable).
+    """
+    d = _branch_direction(rc)
+    if not np.any(d):
+        raise PatternError("no folded state: the pattern has no assignment or target angles")
+    rho0 = magnitude * d / np.max(np.abs(d))
+    hold = int(np.argmax(np.abs(d)))
+    free = np.ones(rc.n_var, bool)
+    free[hold] = False
+    err = np.inf
+    for fix in (True, False):
+        rho = rho0.copy()
+        cols = np.flatnonzero(free) if fix else np.arange(rc.n_var)
+        for _ in range(max_iter):
+            r, J = rc.evaluate(rho)
+            if np.max(np.abs(r), initial=0.0) < 1e-13:
+                break
+            rho[cols] += _min_norm_step(J[:, cols], -r)
+        err = float(rc.closure_error(rho).max()) if len(rc.vertices) else 0.0
+        if err <= 1e-9 and np.max(np.abs(rho)) >= 1e-3 * magnitude:
+            return rho
+    if err > 1e-9:
+        raise PatternError(
+            f"no rigidly folded state found near the flat one (closure error {err:.1e})"
+        )
+    raise PatternError(
+        "the projection of the M/V direction onto the constraints collapses to the flat "
+        "state: the pattern is not rigidly foldable (with rigid panels)"
+    )
+
+
+def _min_norm_step(J: sp.csr_matrix, b: np.ndarray) -> np.ndarray:
+    """Minimum-norm least-squares solution of ``J x = b``."""
+    m, n = J.shape
+    if n <= DENSE_LIMIT:
+        return sla.lstsq(J.toarray(), b, cond=1e-9, lapack_driver="gelsd")[0]
+    import scipy.sparse.linalg as spla
+
+    return spla.lsmr(J, b, atol=1e-14, btol=1e-14, maxiter=20 * n)[0]

@@ -1,0 +1,297 @@
+"""Material and stiffness calibration of bars, bending hinges and fold hinges.
+
+Sources
+-------
+* Filipov, Liu, Tachi, Schenk & Paulino (2017), "Bar and hinge models for scalable analysis
+  of origami", IJSS 124:26-45 (``F17`` below): in-plane bar areas of a rectangular W x H
+  panel in N5B8 (exact for extension and Poisson coupling)::
+
+      A_W = t (H^2 - nu W^2) / (2 H (1 - nu^2)),   A_H = t (W^2 - nu H^2) / (2 W (1 - nu^2)),
+      A_X = nu t (W^2 + H^2)^(3/2) / (2 W H (1 - nu^2))
+
+  (which we recover as the special case of the general fit below); bending hinges
+  ``k_B = C_B D (D_L / t)^(1/3)`` with ``D = E t^3 / (12 (1 - nu^2))``, ``D_L`` the panel
+  diagonal and ``C_B = 0.55``; fold hinges ``k_F = L_F D / L*`` with ``L*`` a crease length
+  scale.
+* Energy matching: a bar of area ``A`` and length ``L`` under a homogeneous in-plane strain
+  stores ``E A L (n.eps.n)^2 / 2``. For each face the bar areas are chosen so that the bars'
+  3x3 (Mandel) stiffness ``sum_b A_b L_b m_b m_b^T``, ``m = (n1^2, n2^2, sqrt2 n1 n2)``,
+  matches the plane-stress membrane ``t Area C / E``. Six entries, generally more or fewer
+  bars: solved in the least-squares sense (minimum norm, non-negative areas). ``"filipov"``
+  drops the shear-shear entry (so the rectangle reproduces F17 exactly, shear stiffness
+  ``2 nu / (1 - nu)`` of the membrane's); ``"fit"`` keeps all six entries with equal weight
+  (the improvement documented in docs/calibration.md).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+from scipy.optimize import lsq_linear
+
+from barhinge.errors import ConfigError
+from barhinge.model.topology import Topology
+from barhinge.model.triangulate import Triangulation
+from barhinge.pattern.crease import CreasePattern
+
+__all__ = [
+    "Material",
+    "BEND_COEFFICIENT_F17",
+    "DEFAULT_LSTAR_OVER_T",
+    "bar_areas",
+    "bend_stiffness",
+    "bend_stiffness_kirchhoff",
+    "face_areas",
+    "plate_bend_scale",
+    "fold_stiffness",
+    "membrane_fit_matrices",
+]
+
+#: Filipov et al. (2017) bending coefficient C_B for N5B8 / N4B5 panels.
+BEND_COEFFICIENT_F17 = 0.55
+#: lower bound of a bar area in the fit, as a fraction of t * face area / total bar length
+#: (keeps every bar load-bearing, so no in-plane mechanism appears; see docs/calibration.md)
+MIN_AREA_FRACTION = 0.1
+#: default crease length scale L* / t when neither fold_stiffness nor L* is given.
+DEFAULT_LSTAR_OVER_T = 100.0
+
+
+@dataclasses.dataclass(frozen=True)
+class Material:
+    """Isotropic thin sheet.
+
+    Parameters
+    ----------
+    E : Young's modulus (force / length^2).
+    nu : Poisson's ratio, in (-1, 0.5].
+    t : thickness (length).
+    """
+
+    E: float = 1.0e6
+    nu: float = 0.3
+    t: float = 0.01
+
+    def __post_init__(self) -> None:
+        if not self.E > 0:
+            raise ConfigError(f"Material.E = {self.E}; expected > 0")
+        if not -1.0 < self.nu <= 0.5:
+            raise ConfigError(f"Material.nu = {self.nu}; expected in (-1, 0.5]")
+        if not self.t > 0:
+            raise ConfigError(f"Material.t = {self.t}; expected > 0")
+
+    @property
+    def bending_rigidity(self) -> float:
+        """Plate bending rigidity ``D = E t^3 / (12 (1 - nu^2))`` (force x length)."""
+        return self.E * self.t**3 / (12.0 * (1.0 - self.nu**2))
+
+    def membrane_mandel(self) -> np.ndarray:
+        """(3, 3) plane-stress stiffness in Mandel notation (shear entry ``E/(1+nu)``)."""
+        nu, E = self.nu, self.E
+        c = E / (1.0 - nu * nu)
+        return c * np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 1.0 - nu]])
+
+
+def fold_stiffness(
+    crease_lengths: np.ndarray,
+    material: Material,
+    fold_stiffness: float | None = None,
+    crease_length_scale: float | None = None,
+) -> np.ndarray:
+    """(n,) fold-hinge stiffness (moment per radian): ``L_F * k`` with ``k`` the given
+    stiffness per unit length, else ``D / L*`` (F17), ``L*`` defaulting to
+    ``DEFAULT_LSTAR_OVER_T * t``."""
+    if fold_stiffness is not None and crease_length_scale is not None:
+        raise ConfigError("give fold_stiffness or crease_length_scale, not both")
+    if fold_stiffness is not None:
+        if fold_stiffness < 0:
+            raise ConfigError(f"fold_stiffness = {fold_stiffness}; expected >= 0")
+        k = float(fold_stiffness)
+    else:
+        Ls = DEFAULT_LSTAR_OVER_T * material.t if crease_length_scale is None else crease_length_scale
+        if not Ls > 0:
+            raise ConfigError(f"crease_length_scale = {Ls}; expected > 0")
+        k = material.bending_rigidity / Ls
+    return k * np.asarray(crease_lengths, dtype=float)
+
+
+def bend_stiffness(
+    diagonal_lengths: np.ndarray, material: Material, coefficient: float = BEND_COEFFICIENT_F17
+) -> np.ndarray:
+    """(n,) bending-hinge stiffness ``C_B D (D_L / t)^(1/3)`` (F17), ``D_L`` the length of
+    the panel diagonal the hinge lies on."""
+    DL = np.asarray(diagonal_lengths, dtype=float)
+    return coefficient * material.bending_rigidity * np.cbrt(DL / material.t)
+
+
+def bend_stiffness_kirchhoff(
+    face_area: np.ndarray, diagonal_lengths: np.ndarray, material: Material
+) -> np.ndarray:
+    """(n,) bending-hinge stiffness that reproduces the Kirchhoff twisting energy of a
+    rectangular panel exactly: ``k_B = 2 D (1 - nu) A / D_L^2`` per hinge (A the face area,
+    D_L its diagonal). Derivation (docs/theory-model.md): corner deflections
+    ``+-delta`` rotate each of the 4 half-diagonal hinges of N5B8 (or the one diagonal
+    hinge of N4B5, twice as much) so that the hinge energy is ``8 k_B delta^2 D_L^2/(W H)^2``,
+    while the plate ``w = kappa x y`` with ``kappa = 4 delta / (W H)`` stores
+    ``D (1 - nu) kappa^2 W H`` (Timoshenko & Woinowsky-Krieger 1959, Sec. 11)."""
+    A = np.asarray(face_area, dtype=float)
+    DL = np.asarray(diagonal_lengths, dtype=float)
+    return 2.0 * material.bending_rigidity * (1.0 - material.nu) * A / DL**2
+
+
+def plate_bend_scale(
+    cp: CreasePattern, scheme: str, material: Material, faces: np.ndarray, refine: int = 4
+) -> np.ndarray:
+    """(len(faces),) factor for the ``"kirchhoff"`` bending stiffnesses of each face so that
+    the panel's corner-warping stiffness equals a Kirchhoff plate's (Morley elements,
+    :mod:`barhinge.model.continuum`): ``trace(S_plate) / trace(S_bar)`` of the stiffnesses
+    condensed to the corner deflections (exact for quadrilaterals, which have one warping
+    mode; a least-squares-like average for polygons). Faces of equal shape are computed
+    once."""
+    from barhinge.model.continuum import panel_corner_stiffness, plate_corner_stiffness
+    from barhinge.model.model import BarHingeModel
+
+    X = cp.vertices3d
+    out = np.ones(len(faces))
+    cache: dict[bytes, float] = {}
+    for n, f in enumerate(faces):
+        loop = list(cp.faces[f])
+        P3 = X[loop]
+        e1, e2, _ = _face_frames(X, cp.faces, np.array([f]))
+        Q = np.column_stack([(P3 - P3[0]) @ e1[0], (P3 - P3[0]) @ e2[0]])
+        key = np.round(Q / np.abs(Q).max(), 9).tobytes() + bytes(str(len(loop)), "ascii")
+        if key not in cache:
+            k = len(loop)
+            panel = CreasePattern(
+                Q, [[i, (i + 1) % k] for i in range(k)], ["B"] * k, faces=[list(range(k))]
+            )
+            m = BarHingeModel.from_pattern(
+                panel, scheme, material, bend_calibration="kirchhoff", fold_stiffness=0.0
+            )
+            Sb = panel_corner_stiffness(m, np.arange(k))
+            Sp = plate_corner_stiffness(Q, material, refine)
+            cache[key] = float(np.trace(Sp) / np.trace(Sb)) if np.trace(Sb) > 0 else 1.0
+        out[n] = cache[key]
+    return out
+
+
+def face_areas(cp: CreasePattern, X: np.ndarray) -> np.ndarray:
+    """(n_faces,) area of each face (Newell), in the geometry X (first nodes = vertices)."""
+    out = np.zeros(cp.n_faces)
+    for f, loop in enumerate(cp.faces):
+        P = X[list(loop)]
+        out[f] = 0.5 * np.linalg.norm(np.cross(P, np.roll(P, -1, axis=0)).sum(axis=0))
+    return out
+
+
+def _face_frames(X: np.ndarray, faces: tuple[tuple[int, ...], ...], fids: np.ndarray):
+    """Newell normal, in-plane frame (e1, e2) and area of the faces ``fids``."""
+    k = len(faces[fids[0]])
+    F = np.array([faces[f] for f in fids], dtype=np.int64)
+    P = X[F]  # (nf, k, 3)
+    N = np.cross(P, np.roll(P, -1, axis=1)).sum(axis=1)  # 2 * area * normal
+    twoA = np.linalg.norm(N, axis=1)
+    n = N / twoA[:, None]
+    e1 = P[:, 1 % k] - P[:, 0]
+    e1 -= np.einsum("ni,ni->n", e1, n)[:, None] * n
+    e1 /= np.linalg.norm(e1, axis=1)[:, None]
+    e2 = np.cross(n, e1)
+    return e1, e2, 0.5 * twoA
+
+
+def membrane_fit_matrices(
+    X: np.ndarray, bars: np.ndarray, e1: np.ndarray, e2: np.ndarray
+) -> np.ndarray:
+    """(nf, 6, m) design matrix: column b = upper triangle (rows 11, 22, 33, 12, 13, 23;
+    off-diagonals times sqrt 2) of ``L_b m_b m_b^T`` for the bars ``bars`` (nf, m, 2) of each
+    face in its frame (e1, e2)."""
+    d = X[bars[..., 1]] - X[bars[..., 0]]  # (nf, m, 3)
+    L = np.linalg.norm(d, axis=2)
+    n1 = np.einsum("nmi,ni->nm", d, e1) / L
+    n2 = np.einsum("nmi,ni->nm", d, e2) / L
+    m = np.stack([n1 * n1, n2 * n2, np.sqrt(2.0) * n1 * n2], axis=1)  # (nf, 3, mb)
+    iu = ([0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2])
+    w = np.array([1, 1, 1, np.sqrt(2), np.sqrt(2), np.sqrt(2)])
+    G = m[:, iu[0], :] * m[:, iu[1], :] * L[:, None, :] * w[None, :, None]
+    return G
+
+
+def topo_lengths(X: np.ndarray, bars: np.ndarray) -> np.ndarray:
+    """(nf,) total length of the bars (nf, m, 2) of each face."""
+    return np.linalg.norm(X[bars[..., 1]] - X[bars[..., 0]], axis=-1).sum(axis=-1)
+
+
+def _bounded_fits(G: np.ndarray, y: np.ndarray, a_min: np.ndarray) -> np.ndarray:
+    """Least squares ``G a ~ y`` with ``a >= a_min``, bars of equal direction tied to one
+    area (so a symmetric panel gets a symmetric answer). Faces of the same shape are solved
+    once (keyed on the rounded problem)."""
+    scale = np.abs(G).max(axis=(1, 2))
+    key = np.round(np.concatenate([G.reshape(len(G), -1) / scale[:, None],
+                                   y / scale[:, None], (a_min / scale)[:, None]], axis=1), 9)
+    _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    out = np.empty((len(first), G.shape[2]))
+    for u, f in enumerate(first):
+        Gf = G[f]
+        cols = Gf / np.linalg.norm(Gf, axis=0)
+        group = -np.ones(Gf.shape[1], dtype=np.int64)
+        ng = 0
+        for b in range(Gf.shape[1]):
+            if group[b] >= 0:
+                continue
+            same = (group < 0) & (np.abs(cols - cols[:, [b]]).max(axis=0) < 1e-9)
+            group[same] = ng
+            ng += 1
+        Gt = np.zeros((Gf.shape[0], ng))
+        np.add.at(Gt.T, group, Gf.T)
+        res = lsq_linear(Gt, y[f], bounds=(a_min[f], np.inf))
+        out[u] = res.x[group]
+    return out[inv.ravel()]
+
+
+def bar_areas(
+    cp: CreasePattern,
+    tri: Triangulation,
+    topo: Topology,
+    material: Material,
+    method: str = "fit",
+) -> np.ndarray:
+    """(n_bars,) cross-section areas by face-wise membrane energy matching (module doc).
+
+    ``method``: ``"fit"`` (all six entries) or ``"filipov"`` (shear-shear entry dropped,
+    F17's closed form for rectangles). A bar shared by two faces sums both contributions.
+    """
+    if method not in ("fit", "filipov"):
+        raise ConfigError(f"bar calibration {method!r} is unknown; expected 'fit' or 'filipov'")
+    X = tri.X0
+    pairs = topo.bar_face_pairs  # (bar, face) sorted by bar then face
+    order = np.lexsort((pairs[:, 0], pairs[:, 1]))
+    bf = pairs[order]
+    faces = cp.faces
+    per_face = np.bincount(bf[:, 1], minlength=cp.n_faces)
+    start = np.concatenate([[0], np.cumsum(per_face)])
+    C = material.membrane_mandel() * material.t / material.E
+    iu = ([0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2])
+    wy = np.array([1, 1, 1, np.sqrt(2), np.sqrt(2), np.sqrt(2)])
+    y_unit = C[iu] * wy  # per unit area
+    row_w = np.ones(6)
+    if method == "filipov":
+        row_w[2] = 0.0
+    area = np.zeros(len(topo.bars))
+    # group faces by (number of corners, number of bars): same shape of the problem
+    ncorner = np.array([len(f) for f in faces], dtype=np.int64)
+    groups = ncorner * 1000 + per_face
+    for g in np.unique(groups):
+        fids = np.flatnonzero(groups == g)
+        m = int(per_face[fids[0]])
+        idx = start[fids][:, None] + np.arange(m)[None, :]
+        bar_ids = bf[idx, 0]  # (nf, m)
+        e1, e2, A = _face_frames(X, faces, fids)
+        G = membrane_fit_matrices(X, topo.bars[bar_ids], e1, e2) * row_w[None, :, None]
+        y = (A[:, None] * y_unit[None, :]) * row_w[None, :]
+        sol = np.einsum("nmr,nr->nm", np.linalg.pinv(G), y)
+        a_min = MIN_AREA_FRACTION * material.t * A / topo_lengths(X, topo.bars[bar_ids])
+        bad = np.flatnonzero((sol < a_min[:, None]).any(axis=1))
+        if len(bad):
+            sol[bad] = _bounded_fits(G[bad], y[bad], a_min[bad])
+        np.add.at(area, bar_ids.ravel(), np.maximum(sol, 0.0).ravel())
+    return area

@@ -1,0 +1,316 @@
+"""Continuum reference for the calibration of a single panel (scikit-fem).
+
+* Plane-stress membrane (vector P1 or P2 Lagrange elements), thickness ``t``.
+* Kirchhoff plate (Morley element), bending rigidity ``D = E t^3 / (12 (1 - nu^2))``.
+
+Load cases, chosen so that the bar-and-hinge panel and the continuum see the same
+kinematics:
+
+* :func:`membrane_energy` -- displacements prescribed on the whole boundary, linear along each
+  edge between the corner values (a bar-and-hinge panel's edges are bars, they stay
+  straight); a homogeneous strain then gives the affine field (closed form), a non-affine
+  corner motion gives a genuinely two-dimensional field;
+* :func:`membrane_edge_load` -- a rectangle clamped along one edge, the opposite edge moved
+  rigidly (stretch or shear), the two other edges free;
+* :func:`plate_corner_energy` -- out-of-plane deflections prescribed at the corners only,
+  edges free (the panel's twisting / warping mode). For a rectangle and ``w = kappa x y`` this
+  is exact Kirchhoff theory: ``U = D (1 - nu) kappa^2 W H`` (Timoshenko & Woinowsky-Krieger
+  1959, Sec. 11, pure twist with corner forces ``2 D (1 - nu) kappa``);
+* :func:`panel_energy` -- the linear bar-and-hinge energy of a model with prescribed node
+  displacements (the rest condensed out), for the same comparisons.
+
+Meshes are small (a few hundred elements) so the tests stay fast.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from barhinge.errors import ConfigError
+from barhinge.model.calibrate import Material
+
+__all__ = [
+    "polygon_mesh",
+    "membrane_energy",
+    "membrane_edge_load",
+    "plate_corner_energy",
+    "panel_energy",
+    "panel_errors",
+    "rectangle_edge_load_error",
+    "homogeneous_energy",
+    "strain_modes",
+    "plate_corner_stiffness",
+    "panel_corner_stiffness",
+]
+
+
+def polygon_mesh(P: np.ndarray, refine: int = 3):
+    """skfem ``MeshTri`` of the convex polygon ``P`` (k, 2): a fan from the centroid refined
+    ``refine`` times. The corners are mesh vertices ``0..k-1``."""
+    from skfem import MeshTri
+
+    P = np.asarray(P, dtype=float)
+    k = len(P)
+    pts = np.vstack([P, P.mean(axis=0)])
+    tri = np.array([[i, (i + 1) % k, k] for i in range(k)]).T
+    return MeshTri(pts.T, tri).refined(refine)
+
+
+def _edge_interp(P: np.ndarray, vals: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Values (n, m) at boundary points x (2, n), linear along each polygon edge between the
+    corner values ``vals`` (k, m)."""
+    k = len(P)
+    best = np.full(x.shape[1], np.inf)
+    out = np.zeros((x.shape[1], vals.shape[1]))
+    for e in range(k):
+        a, b = P[e], P[(e + 1) % k]
+        d = b - a
+        s = np.clip(((x.T - a) @ d) / (d @ d), 0.0, 1.0)
+        dist = np.linalg.norm(x.T - (a + s[:, None] * d), axis=1)
+        take = dist < best
+        best[take] = dist[take]
+        out[take] = (1 - s[take, None]) * vals[e] + s[take, None] * vals[(e + 1) % k]
+    return out
+
+
+def _membrane_stiffness(mesh, material: Material, order: int):
+    from skfem import Basis, ElementTriP1, ElementTriP2, ElementVector, asm
+    from skfem.models.elasticity import linear_elasticity
+
+    if order not in (1, 2):
+        raise ConfigError(f"membrane order = {order}; expected 1 or 2")
+    el = ElementVector(ElementTriP1() if order == 1 else ElementTriP2())
+    basis = Basis(mesh, el)
+    E, nu, t = material.E, material.nu, material.t
+    mu = E / (2 * (1 + nu))
+    lam_ps = E * nu / (1 - nu * nu)  # plane-stress Lame parameter
+    K = t * asm(linear_elasticity(lam_ps, mu), basis)
+    return basis, K
+
+
+def _solve_prescribed(K: sp.spmatrix, D: np.ndarray, xD: np.ndarray) -> float:
+    """Energy 1/2 u^T K u with u[D] = xD and the other dofs free (minimising)."""
+    n = K.shape[0]
+    free = np.setdiff1d(np.arange(n), D)
+    K = sp.csr_matrix(K)
+    u = np.zeros(n)
+    u[D] = xD
+    if len(free):
+        rhs = -(K[free][:, D] @ xD)
+        u[free] = spla.spsolve(sp.csc_matrix(K[free][:, free]), rhs)
+    return 0.5 * float(u @ (K @ u))
+
+
+def membrane_energy(
+    P: np.ndarray,
+    material: Material,
+    corner_disp: np.ndarray,
+    order: int = 2,
+    refine: int = 3,
+) -> float:
+    """Plane-stress energy of the polygon ``P`` (k, 2) with the boundary displacement linear
+    along each edge between the corner displacements ``corner_disp`` (k, 2)."""
+    mesh = polygon_mesh(P, refine)
+    basis, K = _membrane_stiffness(mesh, material, order)
+    ix, iy = basis.split_indices()
+    bnd = basis.get_dofs().all()
+    bx = np.intersect1d(bnd, ix)
+    by = np.intersect1d(bnd, iy)
+    vals = np.asarray(corner_disp, dtype=float)
+    ux = _edge_interp(np.asarray(P, float), vals, basis.doflocs[:, bx])[:, 0]
+    uy = _edge_interp(np.asarray(P, float), vals, basis.doflocs[:, by])[:, 1]
+    D = np.concatenate([bx, by])
+    return _solve_prescribed(K, D, np.concatenate([ux, uy]))
+
+
+def membrane_edge_load(
+    W: float, H: float, material: Material, mode: str, order: int = 2, refine: int = 3
+) -> float:
+    """Force (per unit imposed displacement) of a W x H rectangle clamped along ``x = 0``
+    (``mode="stretch"``, the edge ``x = W`` moved by (1, 0)) or along ``y = 0``
+    (``mode="shear"``, the edge ``y = H`` moved by (1, 0)); the other two edges free.
+    Equal to ``2 U`` for the unit displacement."""
+    from skfem import MeshTri
+
+    nx = max(2, int(round(4 * max(W / H, 1.0))))
+    ny = max(2, int(round(4 * max(H / W, 1.0))))
+    mesh = MeshTri.init_tensor(np.linspace(0, W, nx + 1), np.linspace(0, H, ny + 1)).refined(
+        max(refine - 2, 0)
+    )
+    basis, K = _membrane_stiffness(mesh, material, order)
+    ix, iy = basis.split_indices()
+    x = basis.doflocs
+    tol = 1e-12 * max(W, H)
+    if mode == "stretch":
+        fixed = np.abs(x[0]) < tol
+        moved = np.abs(x[0] - W) < tol
+    elif mode == "shear":
+        fixed = np.abs(x[1]) < tol
+        moved = np.abs(x[1] - H) < tol
+    else:
+        raise ConfigError(f"mode {mode!r} is unknown; expected 'stretch' or 'shear'")
+    Dx = np.concatenate([ix[fixed[ix]], ix[moved[ix]]])
+    Dy = np.concatenate([iy[fixed[iy]], iy[moved[iy]]])
+    ux = np.concatenate([np.zeros(fixed[ix].sum()), np.ones(moved[ix].sum())])
+    uy = np.zeros(len(Dy))
+    return 2.0 * _solve_prescribed(K, np.concatenate([Dx, Dy]), np.concatenate([ux, uy]))
+
+
+def plate_corner_energy(
+    P: np.ndarray, material: Material, corner_w: np.ndarray, refine: int = 4
+) -> float:
+    """Kirchhoff-plate (Morley) energy of the polygon ``P`` (k, 2) with the deflection
+    prescribed at the k corners only (all edges free)."""
+    from skfem import Basis, BilinearForm, ElementTriMorley, asm
+    from skfem.helpers import dd, ddot, trace
+
+    mesh = polygon_mesh(P, refine)
+    basis = Basis(mesh, ElementTriMorley())
+    Dp, nu = material.bending_rigidity, material.nu
+
+    @BilinearForm
+    def plate(u, v, w):
+        return Dp * ((1.0 - nu) * ddot(dd(u), dd(v)) + nu * trace(dd(u)) * trace(dd(v)))
+
+    K = asm(plate, basis)
+    k = len(P)
+    D = basis.nodal_dofs[0, :k]
+    return _solve_prescribed(K, D, np.asarray(corner_w, dtype=float))
+
+
+def _condensed(K: sp.spmatrix, keep: np.ndarray, drop: np.ndarray) -> np.ndarray:
+    """Dense Schur complement of K on the dofs ``keep`` (the ``drop`` dofs condensed out,
+    every other dof fixed at zero)."""
+    K = sp.csr_matrix(K)
+    Kkk = K[keep][:, keep].toarray()
+    if len(drop) == 0:
+        return Kkk
+    Kkd = K[keep][:, drop]
+    X = spla.spsolve(sp.csc_matrix(K[drop][:, drop]), Kkd.T.toarray())
+    return Kkk - Kkd @ np.asarray(X).reshape(len(drop), len(keep))
+
+
+def plate_corner_stiffness(P: np.ndarray, material: Material, refine: int = 4) -> np.ndarray:
+    """(k, k) Kirchhoff-plate (Morley) stiffness of the polygon ``P`` condensed to the
+    deflections of its k corners (edges free)."""
+    from skfem import Basis, BilinearForm, ElementTriMorley, asm
+    from skfem.helpers import dd, ddot, trace
+
+    mesh = polygon_mesh(P, refine)
+    basis = Basis(mesh, ElementTriMorley())
+    Dp, nu = material.bending_rigidity, material.nu
+
+    @BilinearForm
+    def plate(u, v, w):
+        return Dp * ((1.0 - nu) * ddot(dd(u), dd(v)) + nu * trace(dd(u)) * trace(dd(v)))
+
+    K = asm(plate, basis)
+    keep = basis.nodal_dofs[0, : len(P)]
+    drop = np.setdiff1d(np.arange(K.shape[0]), keep)
+    return _condensed(K, keep, drop)
+
+
+def panel_corner_stiffness(model, corners: np.ndarray) -> np.ndarray:
+    """(k, k) out-of-plane stiffness of a flat bar-and-hinge panel condensed to the z
+    displacement of the nodes ``corners`` (other z dofs condensed out, in-plane dofs fixed;
+    they decouple at the flat state)."""
+    K = model.tangent(model.X0)
+    keep = 3 * np.asarray(corners) + 2
+    drop = np.setdiff1d(3 * np.arange(model.n_nodes) + 2, keep)
+    return _condensed(K, keep, drop)
+
+
+#: homogeneous in-plane strain modes (eps_xx, eps_yy, eps_xy) of the comparison
+def strain_modes(nu: float) -> dict[str, np.ndarray]:
+    """Uniaxial stress along x and y and pure shear, as 2x2 strain tensors."""
+    return {
+        "uniaxial_x": np.array([[1.0, 0.0], [0.0, -nu]]),
+        "uniaxial_y": np.array([[-nu, 0.0], [0.0, 1.0]]),
+        "shear": np.array([[0.0, 1.0], [1.0, 0.0]]),
+    }
+
+
+def homogeneous_energy(P: np.ndarray, material: Material, eps: np.ndarray) -> float:
+    """Closed-form plane-stress energy ``t A eps:C:eps / 2`` of the polygon ``P`` under the
+    homogeneous strain ``eps`` (2, 2) (what :func:`membrane_energy` gives for affine corner
+    displacements, exactly)."""
+    P = np.asarray(P, float)
+    A = 0.5 * abs(np.sum(P[:, 0] * np.roll(P[:, 1], -1) - np.roll(P[:, 0], -1) * P[:, 1]))
+    e = np.array([eps[0, 0], eps[1, 1], np.sqrt(2.0) * eps[0, 1]])
+    return 0.5 * material.t * A * float(e @ material.membrane_mandel() @ e)
+
+
+def panel_errors(
+    P: np.ndarray,
+    material: Material,
+    scheme: str = "N5B8",
+    bar_calibration: str = "fit",
+    bend_calibration: str = "filipov",
+    plate_refine: int = 4,
+) -> dict[str, float]:
+    """Relative energy errors ``U_bar / U_continuum - 1`` of a single flat panel ``P`` (k, 2):
+    the three homogeneous membrane modes (corner displacements ``eps x``, other nodes free)
+    and, for k >= 4, the corner-warping energy for ``w = (x - xc)(y - yc)`` at the corners
+    (Morley reference)."""
+    from barhinge.model.model import BarHingeModel
+    from barhinge.pattern.crease import CreasePattern
+
+    P = np.asarray(P, float)
+    k = len(P)
+    cp = CreasePattern(P, [[i, (i + 1) % k] for i in range(k)], ["B"] * k, faces=[list(range(k))])
+    m = BarHingeModel.from_pattern(
+        cp, scheme, material, bar_calibration=bar_calibration, bend_calibration=bend_calibration
+    )
+    out: dict[str, float] = {}
+    for name, eps in strain_modes(material.nu).items():
+        pre = np.full((m.n_nodes, 3), np.nan)
+        pre[:, 2] = 0.0
+        pre[:k, :2] = P @ eps.T
+        out[name] = panel_energy(m, pre) / homogeneous_energy(P, material, eps) - 1.0
+    if k >= 4:
+        c = P.mean(axis=0)
+        w = (P[:, 0] - c[0]) * (P[:, 1] - c[1])
+        pre = np.full((m.n_nodes, 3), np.nan)
+        pre[:, :2] = 0.0
+        pre[:k, 2] = w
+        out["warp"] = panel_energy(m, pre) / plate_corner_energy(P, material, w, plate_refine) - 1
+    return out
+
+
+def rectangle_edge_load_error(
+    W: float,
+    H: float,
+    material: Material,
+    mode: str,
+    scheme: str = "N5B8",
+    bar_calibration: str = "fit",
+    refine: int = 3,
+) -> float:
+    """Relative error ``F_bar / F_continuum - 1`` of the force of :func:`membrane_edge_load`
+    (P2 membrane) for a W x H bar-and-hinge panel with the same supports (corners of the
+    clamped edge fixed, corners of the moved edge displaced by (1, 0), other nodes free)."""
+    from barhinge.model.model import BarHingeModel
+    from barhinge.pattern.crease import CreasePattern
+
+    P = np.array([[0, 0], [W, 0], [W, H], [0, H]], float)
+    cp = CreasePattern(P, [[0, 1], [1, 2], [2, 3], [3, 0]], ["B"] * 4, faces=[[0, 1, 2, 3]])
+    m = BarHingeModel.from_pattern(cp, scheme, material, bar_calibration=bar_calibration)
+    fixed, moved = ([0, 3], [1, 2]) if mode == "stretch" else ([0, 1], [2, 3])
+    pre = np.full((m.n_nodes, 3), np.nan)
+    pre[:, 2] = 0.0
+    pre[fixed, :2] = 0.0
+    pre[moved, 0] = 1.0
+    pre[moved, 1] = 0.0
+    F_bar = 2.0 * panel_energy(m, pre)
+    return F_bar / membrane_edge_load(W, H, material, mode, order=2, refine=refine) - 1.0
+
+
+def panel_energy(model, prescribed: np.ndarray) -> float:
+    """Linear bar-and-hinge energy ``1/2 u^T K(X0) u`` with the node displacements
+    ``prescribed`` (n_nodes, 3) where finite and the NaN entries free (condensed out)."""
+    pre = np.asarray(prescribed, dtype=float).ravel()
+    K = model.tangent(model.X0)
+    D = np.flatnonzero(np.isfinite(pre))
+    return _solve_prescribed(K, D, pre[D])

@@ -1,0 +1,437 @@
+"""BarHingeModel: the bar-and-hinge model of a crease pattern (Filipov et al. 2017;
+Liu & Paulino 2017).
+
+Energy ``E(X) = sum_bars W_b(eps_b) + sum_bend W_h(rho_h) + sum_fold W_f(rho_f)``; the
+internal force is ``dE/dX`` and the tangent ``d^2E/dX^2`` (material + geometric parts), both
+exact. Node ordering: the pattern's vertices first (in order), then the centre nodes of N5B8
+quads and polygons.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from barhinge._typing import SCHEMES, Scheme, StrainMeasure
+from barhinge.assembly import Assembler
+from barhinge.errors import ConfigError
+from barhinge.kernels.geometry import (
+    bar_strain_derivatives,
+    hinge_angle,
+    hinge_angle_gradient,
+    hinge_energy_hessian_packed,
+)
+from barhinge.kernels.laws import bar_linear, hinge_linear, hinge_penetration
+from barhinge.model.calibrate import (
+    BEND_COEFFICIENT_F17,
+    Material,
+    bar_areas,
+    bend_stiffness,
+    bend_stiffness_kirchhoff,
+    face_areas,
+    fold_stiffness as _fold_stiffness,
+    plate_bend_scale,
+)
+from barhinge.model.topology import build_topology
+from barhinge.model.triangulate import triangulate
+from barhinge.pattern.crease import CreasePattern
+
+__all__ = ["BarHingeModel", "Evaluation", "FOLD_LAWS"]
+
+FOLD_LAWS = ("linear", "penetration")
+
+# packed upper triangle of a bar's 6x6 [[k, -k], [-k, k]]: source entry of the 3x3 k, sign
+_r6, _c6 = np.triu_indices(6)
+_BAR_SRC = (_r6 % 3) * 3 + (_c6 % 3)
+_BAR_SIGN = np.where((_r6 < 3) == (_c6 < 3), 1.0, -1.0)
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Evaluation:
+    """Result of one :meth:`BarHingeModel.evaluate` pass.
+
+    Attributes
+    ----------
+    energy_bars, energy_bend, energy_fold : float
+        Stored energy in bars, bending hinges and fold hinges.
+    force : (n_dof,) float
+        Internal force ``dE/dX`` (flattened ``(n_nodes, 3)``, xyz interleaved).
+    K : csr (n_dof, n_dof) or None
+        Tangent stiffness ``d^2E/dX^2`` (None if ``tangent=False``).
+    bar_strain : (n_bars,) float
+    bar_force : (n_bars,) float
+        Axial force ``EA eps`` (tension > 0).
+    hinge_angle : (n_hinges,) float
+        Radians, FOLD convention.
+    hinge_moment : (n_hinges,) float
+        ``dW/drho`` (moment per hinge, force x length).
+    """
+
+    energy_bars: float
+    energy_bend: float
+    energy_fold: float
+    force: np.ndarray
+    K: sp.csr_matrix | None
+    bar_strain: np.ndarray
+    bar_force: np.ndarray
+    hinge_angle: np.ndarray
+    hinge_moment: np.ndarray
+
+    @property
+    def energy(self) -> float:
+        """Total stored energy."""
+        return self.energy_bars + self.energy_bend + self.energy_fold
+
+
+def _ro(a: np.ndarray) -> np.ndarray:
+    a = np.ascontiguousarray(a)
+    a.setflags(write=False)
+    return a
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class BarHingeModel:
+    """A bar-and-hinge model. Build it with :meth:`from_pattern`; all arrays are read-only.
+
+    Attributes
+    ----------
+    pattern : CreasePattern
+    scheme : "N4B5" | "N5B8"
+    material : Material
+    X0 : (n_nodes, 3) reference coordinates.
+    bars : (n_bars, 2) int; bar_EA, bar_L0 : (n_bars,)
+    hinges : (n_hinges, 4) int (i, j, k, l)
+    hinge_kind : (n_hinges,) "fold" | "bend"
+    hinge_edge, hinge_face : (n_hinges,) int (-1 where not applicable)
+    hinge_k : (n_hinges,) rotational stiffness (moment per radian, length included)
+    rest_angle : (n_hinges,) rad, FOLD convention
+    fold_law : "linear" | "penetration"
+    fold_limits : (rho_min, rho_max) radians of the penetration law
+    strain : "green" | "engineering"
+    """
+
+    pattern: CreasePattern
+    scheme: Scheme
+    material: Material
+    X0: np.ndarray
+    bars: np.ndarray
+    bar_EA: np.ndarray
+    bar_L0: np.ndarray
+    hinges: np.ndarray
+    hinge_kind: np.ndarray
+    hinge_edge: np.ndarray
+    hinge_face: np.ndarray
+    hinge_k: np.ndarray
+    rest_angle: np.ndarray
+    fold_law: str = "linear"
+    fold_limits: tuple[float, float] = (-0.75 * np.pi, 0.75 * np.pi)
+    strain: StrainMeasure = "green"
+    meta: dict[str, Any] = dataclasses.field(default_factory=dict)
+
+    # ------------------------------------------------------------------ creation
+    @classmethod
+    def from_pattern(
+        cls,
+        cp: CreasePattern,
+        scheme: Scheme = "N5B8",
+        material: Material | None = None,
+        *,
+        fold_stiffness: float | None = None,
+        crease_length_scale: float | None = None,
+        stiffness_ratio: float | None = None,
+        fold_law: str = "linear",
+        fold_limits_deg: tuple[float, float] = (-135.0, 135.0),
+        bar_calibration: str = "fit",
+        bend_coefficient: float = BEND_COEFFICIENT_F17,
+        bend_calibration: str = "filipov",
+        bar_EA: np.ndarray | float | None = None,
+        bend_k: np.ndarray | float | None = None,
+        fold_k: np.ndarray | float | None = None,
+        strain: StrainMeasure = "green",
+    ) -> BarHingeModel:
+        """Triangulate ``cp`` and calibrate the stiffnesses.
+
+        Parameters
+        ----------
+        cp : CreasePattern, in any state; its state becomes the stress-free reference
+            (rest angles = state fold angles).
+        scheme : ``"N4B5"`` or ``"N5B8"`` for quadrilateral faces.
+        material : Material (default ``Material()``).
+        fold_stiffness : fold stiffness per unit crease length (moment per radian per length);
+            or ``crease_length_scale`` L*: ``k = E t^3 / (12 (1 - nu^2) L*)`` (Filipov et al.
+            2017). Default ``L* = 100 t``.
+        stiffness_ratio : multiply bar EA and bending stiffness by this factor (rigid-panel
+            limit studies).
+        fold_law : ``"linear"`` or ``"penetration"`` (Liu & Paulino 2017) with
+            ``fold_limits_deg``.
+        bar_calibration : ``"fit"`` (default, all membrane moduli) or ``"filipov"``.
+        bend_coefficient : ``C_B`` of the Filipov bending stiffness.
+        bend_calibration : ``"filipov"`` (default, ``C_B D (D_L/t)^(1/3)``) or
+            ``"kirchhoff"`` (``2 D (1 - nu) A / D_L^2``, exact twisting of a rectangular
+            Kirchhoff plate) or ``"plate"`` (``"kirchhoff"`` scaled per face shape so that
+            the panel's corner-warping stiffness equals a Morley plate's; exact for every
+            quadrilateral; one small FE solve per distinct face shape). See
+            docs/calibration.md.
+        bar_EA, bend_k, fold_k : overrides (scalar or per-element array: per bar, per bend
+            hinge in model order, per fold hinge in model order).
+        strain : ``"green"`` or ``"engineering"`` bar strain.
+        """
+        if scheme not in SCHEMES:
+            raise ConfigError(f"scheme {scheme!r} is unknown; expected one of {', '.join(SCHEMES)}")
+        if fold_law not in FOLD_LAWS:
+            raise ConfigError(f"fold_law {fold_law!r} is unknown; expected one of {FOLD_LAWS}")
+        if strain not in ("green", "engineering"):
+            raise ConfigError(f"strain {strain!r} is unknown; expected 'green' or 'engineering'")
+        lo, hi = (float(v) for v in fold_limits_deg)
+        if not -180.0 < lo < 0.0 < hi < 180.0:
+            raise ConfigError(
+                f"fold_limits_deg = {fold_limits_deg}; expected -180 < min < 0 < max < 180"
+            )
+        mat = Material() if material is None else material
+        tri = triangulate(cp, scheme)
+        topo = build_topology(cp, tri)
+        X0 = tri.X0
+        bars, hinges = topo.bars, topo.hinges
+        L0 = np.linalg.norm(X0[bars[:, 1]] - X0[bars[:, 0]], axis=1)
+        is_fold = topo.hinge_kind == "fold"
+        is_bend = ~is_fold
+        axis_len = np.linalg.norm(X0[hinges[:, 1]] - X0[hinges[:, 0]], axis=1)
+
+        EA = mat.E * bar_areas(cp, tri, topo, mat, bar_calibration)
+        # diagonal the bending hinge lies on: the axis itself (N4B5) or corner-centre-corner
+        centred = (hinges[:, :2] >= cp.n_vertices).any(axis=1)
+        DL = np.where(centred, 2.0 * axis_len, axis_len)
+        k = np.zeros(len(hinges))
+        if bend_calibration == "filipov":
+            k[is_bend] = bend_stiffness(DL[is_bend], mat, bend_coefficient)
+        elif bend_calibration in ("kirchhoff", "plate"):
+            area = face_areas(cp, X0)[topo.hinge_face[is_bend]]
+            k[is_bend] = bend_stiffness_kirchhoff(area, DL[is_bend], mat)
+            if bend_calibration == "plate" and is_bend.any():
+                hf = topo.hinge_face[is_bend]
+                uf, inv = np.unique(hf, return_inverse=True)
+                k[is_bend] *= plate_bend_scale(cp, scheme, mat, uf)[inv.ravel()]
+        else:
+            raise ConfigError(
+                f"bend_calibration {bend_calibration!r} is unknown; expected 'filipov', "
+                "'kirchhoff' or 'plate'"
+            )
+        k[is_fold] = _fold_stiffness(axis_len[is_fold], mat, fold_stiffness, crease_length_scale)
+        if bar_EA is not None:
+            EA = _override(EA, bar_EA, len(bars), "bar_EA")
+        if bend_k is not None:
+            k[is_bend] = _override(k[is_bend], bend_k, int(is_bend.sum()), "bend_k")
+        if fold_k is not None:
+            k[is_fold] = _override(k[is_fold], fold_k, int(is_fold.sum()), "fold_k")
+        if stiffness_ratio is not None:
+            if not stiffness_ratio > 0:
+                raise ConfigError(f"stiffness_ratio = {stiffness_ratio}; expected > 0")
+            EA = EA * stiffness_ratio
+            k[is_bend] *= stiffness_ratio
+        rest = hinge_angle(X0, hinges)
+        return cls(
+            pattern=cp,
+            scheme=scheme,
+            material=mat,
+            X0=_ro(X0),
+            bars=_ro(bars),
+            bar_EA=_ro(EA),
+            bar_L0=_ro(L0),
+            hinges=_ro(hinges),
+            hinge_kind=_ro(topo.hinge_kind),
+            hinge_edge=_ro(topo.hinge_edge),
+            hinge_face=_ro(topo.hinge_face),
+            hinge_k=_ro(k),
+            rest_angle=_ro(rest),
+            fold_law=fold_law,
+            fold_limits=(np.radians(lo), np.radians(hi)),
+            strain=strain,
+            meta={
+                "bar_calibration": bar_calibration,
+                "bend_calibration": bend_calibration,
+                "bend_coefficient": bend_coefficient,
+            },
+        )
+
+    def with_(self, **changes: Any) -> BarHingeModel:
+        """A new model with some fields replaced (arrays are validated for length)."""
+        kw = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        for name, val in changes.items():
+            if name not in kw:
+                raise ConfigError(f"BarHingeModel has no field {name!r}")
+            if isinstance(kw[name], np.ndarray):
+                val = np.array(val, dtype=kw[name].dtype)
+                if val.shape != kw[name].shape:
+                    raise ConfigError(
+                        f"{name} must have shape {kw[name].shape}, got {val.shape}"
+                    )
+                val = _ro(val)
+            kw[name] = val
+        return BarHingeModel(**kw)
+
+    def stiffened(self, ratio: float) -> BarHingeModel:
+        """A new model with bar EA and bending stiffness multiplied by ``ratio``."""
+        if not ratio > 0:
+            raise ConfigError(f"stiffness ratio = {ratio}; expected > 0")
+        k = np.array(self.hinge_k)
+        k[self.hinge_kind == "bend"] *= ratio
+        return self.with_(bar_EA=self.bar_EA * ratio, hinge_k=k)
+
+    # ------------------------------------------------------------------ sizes
+    @property
+    def n_nodes(self) -> int:
+        return len(self.X0)
+
+    @property
+    def n_dof(self) -> int:
+        return 3 * len(self.X0)
+
+    @property
+    def n_bars(self) -> int:
+        return len(self.bars)
+
+    @property
+    def n_hinges(self) -> int:
+        return len(self.hinges)
+
+    @cached_property
+    def fold_hinge_of_edge(self) -> np.ndarray:
+        """(n_edges,) hinge index of each pattern edge's fold hinge, -1 if none."""
+        out = -np.ones(self.pattern.n_edges, dtype=np.int64)
+        f = np.flatnonzero(self.hinge_kind == "fold")
+        out[self.hinge_edge[f]] = f
+        return _ro(out)
+
+    @cached_property
+    def _is_fold(self) -> np.ndarray:
+        return _ro(self.hinge_kind == "fold")
+
+    @cached_property
+    def fold_limits_per_hinge(self) -> tuple[np.ndarray, np.ndarray]:
+        """(rho_min, rho_max) of the penetration law for each fold hinge (model order of the
+        fold hinges): ``fold_limits`` widened to the rest angle where the rest angle lies
+        beyond a limit (that crease's stiffening branch starts at its rest angle, so the
+        reference state stays stress-free)."""
+        r0 = self.rest_angle[self._is_fold]
+        lo, hi = self.fold_limits
+        return _ro(np.minimum(lo, r0)), _ro(np.maximum(hi, r0))
+
+    @cached_property
+    def assembler(self) -> Assembler:
+        """Sparsity pattern and scatter maps (built once)."""
+        return Assembler(self.n_nodes, [self.bars, self.hinges])
+
+    # ------------------------------------------------------------------ evaluation
+    def _hinge_law(self, rho: np.ndarray):
+        M, Kt, W = hinge_linear(rho, self.rest_angle, self.hinge_k)
+        if self.fold_law == "penetration":
+            f = self._is_fold
+            lo, hi = self.fold_limits_per_hinge
+            Mf, Kf, Wf = hinge_penetration(rho[f], self.rest_angle[f], self.hinge_k[f], lo, hi)
+            M[f], Kt[f], W[f] = Mf, Kf, Wf
+        return M, Kt, W
+
+    def _check_X(self, X: np.ndarray) -> np.ndarray:
+        X = np.asarray(X, dtype=float)
+        if X.shape == (self.n_dof,):
+            X = X.reshape(-1, 3)
+        if X.shape != (self.n_nodes, 3):
+            raise ConfigError(f"X must have shape ({self.n_nodes}, 3), got {X.shape}")
+        return X
+
+    def evaluate(self, X: np.ndarray, tangent: bool = True) -> Evaluation:
+        """Energy split, internal force and (optionally) the tangent at ``X`` in one pass.
+
+        Parameters
+        ----------
+        X : (n_nodes, 3) or (n_dof,) float
+        tangent : also assemble the sparse tangent stiffness.
+        """
+        X = self._check_X(X)
+        bars, hinges = self.bars, self.hinges
+        eps, d, B = bar_strain_derivatives(X, bars, self.bar_L0, self.strain)
+        S, dS, Wb = bar_linear(eps, self.bar_EA, self.bar_L0)
+        fb = (S[:, None] * d).T  # (3, nb)
+        fe_bar = np.concatenate([-fb, fb], axis=0)
+        asm = self.assembler
+        if tangent:
+            flat, (Kb, Hp) = asm.value_buffers()
+            # g (12, nh), Hp (78, nh): packed upper triangle of the hinge energy Hessian
+            rho, M, Kt, Wh, g, _ = hinge_energy_hessian_packed(X, hinges, self._hinge_law, Hp)
+        else:
+            rho, g = hinge_angle_gradient(X, hinges)
+            g = g.T
+            M, Kt, Wh = self._hinge_law(rho)
+        force = asm.force([fe_bar, M * g])
+        K = None
+        if tangent:
+            # bar: [[k, -k], [-k, k]] with k = S'' d d^T + S B, packed upper triangle of 6x6
+            kb = dS[:, None, None] * d[:, :, None] * d[:, None, :] + S[:, None, None] * B
+            kb = kb.reshape(len(bars), 9).T
+            np.multiply(kb[_BAR_SRC], _BAR_SIGN[:, None], out=Kb)
+            K = asm.matrix_packed(flat)
+        f = self._is_fold
+        return Evaluation(
+            energy_bars=float(Wb.sum()),
+            energy_bend=float(Wh[~f].sum()),
+            energy_fold=float(Wh[f].sum()),
+            force=force,
+            K=K,
+            bar_strain=eps,
+            bar_force=self.bar_EA * eps,
+            hinge_angle=rho,
+            hinge_moment=M,
+        )
+
+    def energy(self, X: np.ndarray) -> float:
+        """Total stored energy at ``X``."""
+        X = self._check_X(X)
+        from barhinge.kernels.geometry import bar_strain
+
+        eps = bar_strain(X, self.bars, self.bar_L0, self.strain)
+        _, _, Wb = bar_linear(eps, self.bar_EA, self.bar_L0)
+        _, _, Wh = self._hinge_law(hinge_angle(X, self.hinges))
+        return float(Wb.sum() + Wh.sum())
+
+    def internal_force(self, X: np.ndarray) -> np.ndarray:
+        """(n_dof,) internal force ``dE/dX``."""
+        return self.evaluate(X, tangent=False).force
+
+    def tangent(self, X: np.ndarray) -> sp.csr_matrix:
+        """(n_dof, n_dof) CSR tangent stiffness ``d^2E/dX^2``."""
+        K = self.evaluate(X, tangent=True).K
+        assert K is not None
+        return K
+
+    def hinge_angles(self, X: np.ndarray) -> np.ndarray:
+        """(n_hinges,) fold angles in radians, FOLD convention (valley > 0)."""
+        return hinge_angle(self._check_X(X), self.hinges)
+
+    def crease_fold_angles_deg(self, X: np.ndarray) -> np.ndarray:
+        """(n_edges,) fold angle of every pattern edge in degrees (0 where no fold hinge)."""
+        X = self._check_X(X)
+        out = np.zeros(self.pattern.n_edges)
+        h = self.fold_hinge_of_edge
+        has = h >= 0
+        out[has] = np.degrees(hinge_angle(X, self.hinges[h[has]]))
+        return out
+
+    def __repr__(self) -> str:
+        nf = int(self._is_fold.sum())
+        return (
+            f"BarHingeModel(scheme={self.scheme}, n_nodes={self.n_nodes}, n_bars={self.n_bars}, "
+            f"fold_hinges={nf}, bend_hinges={self.n_hinges - nf}, fold_law={self.fold_law})"
+        )
+
+
+def _override(current: np.ndarray, value: Any, n: int, name: str) -> np.ndarray:
+    v = np.asarray(value, dtype=float)
+    if v.ndim == 0:
+        return np.full(n, float(v))
+    if v.shape != (n,):
+        raise ConfigError(f"{name} must be a scalar or have shape ({n},), got {v.shape}")
+    return v.copy()

@@ -1,0 +1,100 @@
+"""Triangulation of a crease pattern's faces for the bar-and-hinge model.
+
+* triangles are kept as they are;
+* quadrilaterals by ``N4B5`` (split along the shorter diagonal, which becomes a bending
+  hinge) or ``N5B8`` (a centre node at the mean of the four corners joined to them: 8 bars,
+  4 bending hinges) -- Filipov et al. (2017, IJSS, Fig. 5);
+* polygons with more than four corners by a centre node (mean of the corners) joined to every
+  corner, in both schemes.
+
+Triangles keep the counter-clockwise orientation of their face, so every triangle normal
+points to the side of the face normal (the side a valley fold closes towards).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from barhinge._typing import SCHEMES, Scheme
+from barhinge.errors import ConfigError
+from barhinge.pattern.crease import CreasePattern
+
+__all__ = ["Triangulation", "triangulate"]
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Triangulation:
+    """Triangles of a pattern.
+
+    Attributes
+    ----------
+    X0 : (n_nodes, 3) float
+        Node coordinates: the pattern's vertices first (in order), then centre nodes.
+    triangles : (n_tri, 3) int
+        Counter-clockwise node triples.
+    tri_face : (n_tri,) int
+        Pattern face of each triangle.
+    centre_face : (n_nodes - n_vertices,) int
+        Face of each added centre node.
+    """
+
+    X0: np.ndarray
+    triangles: np.ndarray
+    tri_face: np.ndarray
+    centre_face: np.ndarray
+
+
+def triangulate(cp: CreasePattern, scheme: Scheme = "N5B8") -> Triangulation:
+    """Triangulate every face of ``cp`` with ``scheme`` (``"N4B5"`` or ``"N5B8"``).
+
+    The geometry used (shorter diagonal, centre nodes) is the pattern's current state
+    ``cp.vertices3d``; a centre node is the mean of its face's corners, so in a folded,
+    non-planar quad the rest angles of its bending hinges take up the state.
+    """
+    if scheme not in SCHEMES:
+        raise ConfigError(f"scheme {scheme!r} is unknown; expected one of {', '.join(SCHEMES)}")
+    V = np.array(cp.vertices3d, dtype=float)
+    nv = len(V)
+    tris: list[np.ndarray] = []
+    tface: list[np.ndarray] = []
+    centres: list[np.ndarray] = []
+    cface: list[np.ndarray] = []
+    next_node = nv
+    sizes = np.array([len(f) for f in cp.faces], dtype=np.int64)
+    for k in np.unique(sizes):
+        fid = np.flatnonzero(sizes == k)
+        F = np.array([cp.faces[i] for i in fid], dtype=np.int64)  # (nf, k)
+        if k == 3:
+            tris.append(F)
+            tface.append(fid)
+            continue
+        if k == 4 and scheme == "N4B5":
+            d02 = np.linalg.norm(V[F[:, 2]] - V[F[:, 0]], axis=1)
+            d13 = np.linalg.norm(V[F[:, 3]] - V[F[:, 1]], axis=1)
+            # roll so that the split diagonal is always corners 0-2
+            Fr = np.where((d13 < d02)[:, None], np.roll(F, -1, axis=1), F)
+            tris.append(np.stack([Fr[:, [0, 1, 2]], Fr[:, [0, 2, 3]]], axis=1).reshape(-1, 3))
+            tface.append(np.repeat(fid, 2))
+            continue
+        c = next_node + np.arange(len(fid))
+        next_node += len(fid)
+        centres.append(V[F].mean(axis=1))
+        cface.append(fid)
+        T = np.empty((len(fid), k, 3), dtype=np.int64)
+        T[:, :, 0] = F
+        T[:, :, 1] = np.roll(F, -1, axis=1)
+        T[:, :, 2] = c[:, None]
+        tris.append(T.reshape(-1, 3))
+        tface.append(np.repeat(fid, k))
+    X0 = np.vstack([V, *centres]) if centres else V
+    triangles = np.vstack(tris) if tris else np.zeros((0, 3), dtype=np.int64)
+    tri_face = np.concatenate(tface) if tface else np.zeros(0, dtype=np.int64)
+    order = np.argsort(tri_face, kind="stable")
+    return Triangulation(
+        X0=X0,
+        triangles=triangles[order],
+        tri_face=tri_face[order],
+        centre_face=np.concatenate(cface) if cface else np.zeros(0, dtype=np.int64),
+    )

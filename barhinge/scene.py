@@ -1,0 +1,512 @@
+"""Scene: a bar-and-hinge model with supports, loads, prescribed displacements, actuators
+and a control schedule; TOML loading; the built-in default scene.
+
+Every driven quantity follows one path parameter ``t`` in [0, 1] reached in ``steps`` equal
+requested steps: loads are ``t * loads`` (the load factor is ``t``), prescribed displacements
+are ``t * prescribed`` and actuator fold angles follow their schedule (linear in ``t`` or a
+per-step table). Under arc-length control the load factor is an unknown instead of ``t``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+import tomllib
+import typing
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from barhinge._typing import ControlKind
+from barhinge.actuators import Actuators
+from barhinge.errors import ConfigError, PatternError
+from barhinge.solve.options import SolverOptions
+
+__all__ = [
+    "Scene",
+    "default_scene",
+    "load_scene",
+    "restraint_321",
+    "scene_from_dict",
+    "select_vertices",
+    "self_weight",
+]
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Scene:
+    """What to solve: a model and how it is held, loaded and driven.
+
+    Parameters
+    ----------
+    model : BarHingeModel
+        The structure (anything with ``X0``, ``evaluate``, ``hinges`` ... see ``solve``).
+    supports : (n_nodes, 3) bool, optional
+        Fixed DOFs (True = fixed at its initial position). ``None`` with no prescribed
+        displacements gives the minimal 3-2-1 restraint of :func:`restraint_321`.
+    loads : (n_nodes, 3) float, optional
+        Reference nodal loads, scaled by the load factor.
+    prescribed : (n_nodes, 3) float, optional
+        Prescribed displacement of each DOF at the end of the path (NaN = not prescribed);
+        reached linearly. Prescribed DOFs are eliminated like supports.
+    actuators : Actuators, optional
+        Creases whose fold angles follow a schedule (Lagrange-multiplier constraints).
+    steps : int
+        Number of requested steps (states 1..steps of the result).
+    control : str
+        ``"fold_angle"``, ``"displacement"``, ``"load"``, ``"arc_length"`` or ``"auto"``
+        (fold angle if actuators, else displacement if prescribed, else load).
+    options : SolverOptions or dict, optional
+    name : str
+    """
+
+    model: Any
+    supports: np.ndarray | None = None
+    loads: np.ndarray | None = None
+    prescribed: np.ndarray | None = None
+    actuators: Actuators | None = None
+    steps: int = 50
+    control: str = "auto"
+    options: SolverOptions | dict | None = None
+    name: str = "scene"
+
+    def __post_init__(self) -> None:
+        n = int(self.model.n_nodes)
+        auto = False
+        if self.prescribed is not None:
+            P = _node_array(self.prescribed, n, "prescribed", float)
+        else:
+            P = np.full((n, 3), np.nan)
+        if self.supports is None:
+            S = np.zeros((n, 3), bool)
+            if not np.isfinite(P).any():
+                S = restraint_321(self.model)
+                auto = True
+        else:
+            S = _node_array(self.supports, n, "supports", bool)
+        both = S & np.isfinite(P)
+        if both.any():
+            i, c = np.argwhere(both)[0]
+            raise ConfigError(f"node {i} component {'xyz'[c]} is both supported and prescribed")
+        L = np.zeros((n, 3)) if self.loads is None else _node_array(self.loads, n, "loads", float)
+        if not isinstance(self.steps, int | np.integer) or self.steps < 1:
+            raise ConfigError(f"steps = {self.steps!r}; expected an integer >= 1")
+        acts = self.actuators
+        if acts is not None and not isinstance(acts, Actuators):
+            raise ConfigError(f"actuators must be an Actuators object, got {type(acts).__name__}")
+        if acts is not None and acts.n:
+            ne = len(self.model.fold_hinge_of_edge)
+            bad = [int(e) for e in acts.edges if e < 0 or e >= ne]
+            if bad:
+                raise ConfigError(f"actuator edge {bad[0]} is not an edge id (0..{ne - 1})")
+            no_hinge = [int(e) for e in acts.edges if self.model.fold_hinge_of_edge[e] < 0]
+            if no_hinge:
+                raise ConfigError(f"actuator edge {no_hinge[0]} has no fold hinge (not a crease)")
+        control = self.control
+        if control == "auto":
+            if acts is not None and acts.n:
+                control = "fold_angle"
+            elif np.isfinite(P).any():
+                control = "displacement"
+            else:
+                control = "load"
+        if control not in CONTROLS:
+            raise ConfigError(f"control = {control!r}; expected one of {', '.join(CONTROLS)}")
+        if control == "fold_angle" and (acts is None or not acts.n):
+            raise ConfigError("control 'fold_angle' needs actuators")
+        if control == "displacement" and not np.isfinite(P).any():
+            raise ConfigError("control 'displacement' needs prescribed displacements")
+        if control in ("load", "arc_length") and not np.any(L):
+            raise ConfigError(f"control {control!r} needs nonzero loads")
+        opts = self.options
+        if opts is None or isinstance(opts, dict):
+            opts = SolverOptions.from_dict(opts)
+        elif not isinstance(opts, SolverOptions):
+            raise ConfigError(f"options must be SolverOptions or a dict, got {type(opts).__name__}")
+        object.__setattr__(self, "supports", S)
+        object.__setattr__(self, "loads", L)
+        object.__setattr__(self, "prescribed", P)
+        object.__setattr__(self, "control", control)
+        object.__setattr__(self, "options", opts)
+        object.__setattr__(self, "steps", int(self.steps))
+        object.__setattr__(self, "_auto_restrained", auto)
+
+    @property
+    def auto_restrained(self) -> bool:
+        """True when the supports are the automatic 3-2-1 restraint."""
+        return bool(self._auto_restrained)  # type: ignore[attr-defined]
+
+    @property
+    def fixed(self) -> np.ndarray:
+        """(n_nodes, 3) bool: DOFs removed from the unknowns (supports and prescribed)."""
+        return self.supports | np.isfinite(self.prescribed)
+
+    def actuator_hinges(self) -> np.ndarray:
+        """(n_act,) int: model hinge index of each actuator."""
+        if self.actuators is None:
+            return np.zeros(0, np.int64)
+        return np.asarray(self.model.fold_hinge_of_edge, np.int64)[self.actuators.edges]
+
+    def actuator_schedule_deg(self) -> np.ndarray:
+        """(steps + 1, n_act) prescribed actuator angles (row 0 = angles of ``model.X0``)."""
+        if self.actuators is None or not self.actuators.n:
+            return np.zeros((self.steps + 1, 0))
+        start = np.degrees(self.model.hinge_angles(self.model.X0)[self.actuator_hinges()])
+        return self.actuators.schedule(self.steps, start_deg=start)
+
+    def with_(self, **changes: Any) -> Scene:
+        """A copy with some fields replaced."""
+        kw = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        kw.update(changes)
+        if "supports" not in changes and self.auto_restrained:
+            kw["supports"] = None
+        return Scene(**kw)
+
+
+def _node_array(a: Any, n: int, what: str, dtype: type) -> np.ndarray:
+    arr = np.asarray(a, dtype=dtype)
+    if arr.shape != (n, 3):
+        raise ConfigError(f"{what} must have shape (n_nodes, 3) = ({n}, 3), got {arr.shape}")
+    if dtype is float and what != "prescribed" and not np.all(np.isfinite(arr)):
+        raise ConfigError(f"{what} has non-finite entries")
+    return arr.copy()
+
+
+# ------------------------------------------------------------------------------ supports
+def restraint_321(model: Any) -> np.ndarray:
+    """Minimal 3-2-1 restraint of a free-floating model, (n_nodes, 3) bool.
+
+    Node A (the pattern vertex nearest the centroid) is fixed in x, y, z; node B (farthest
+    from A) in the two components across AB; node C (farthest from line AB) in the component
+    along the normal of the plane ABC, which stops the rotation about AB. Removes exactly the
+    six rigid-body modes (checked by rank) and adds no stress.
+    """
+    X = np.asarray(model.X0, float)
+    nv = len(model.pattern.vertices) if hasattr(model, "pattern") else len(X)
+    V = X[:nv]
+    a = int(np.argmin(np.linalg.norm(V - V.mean(0), axis=1)))
+    b = int(np.argmax(np.linalg.norm(V - V[a], axis=1)))
+    ab = V[b] - V[a]
+    cross = np.cross(ab, V - V[a])
+    c = int(np.argmax(np.linalg.norm(cross, axis=1)))
+    S = np.zeros((len(X), 3), bool)
+    S[a] = True
+    S[b, np.argsort(np.abs(ab))[:2]] = True
+    S[c, int(np.argmax(np.abs(cross[c])))] = True
+    # check: the six rigid-body velocities restricted to the fixed DOFs have rank 6
+    rows = []
+    for node in (a, b, c):
+        x = X[node]
+        modes = np.hstack([np.eye(3), -_skew(x)])  # v = t + w x r  -> [I, -[r]x] @ (t, w)
+        rows.append(modes[S[node]])
+    if np.linalg.matrix_rank(np.vstack(rows), tol=1e-9 * max(1.0, float(np.ptp(V)))) < 6:
+        raise PatternError("cannot restrain the pattern automatically (its vertices are collinear)")
+    return S
+
+
+def _skew(r: np.ndarray) -> np.ndarray:
+    return np.array([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
+
+
+def select_vertices(model: Any, where: str | list[str], tol: float = 1e-6) -> np.ndarray:
+    """Vertex ids chosen by name, intersected over a list of names.
+
+    Names: ``all``, ``boundary``, ``left``/``right`` (min/max x), ``bottom``/``top`` (min/max
+    y), ``zmin``/``zmax`` (min/max z), evaluated on the pattern's vertices at ``model.X0``
+    with tolerance ``tol`` times the pattern size.
+    """
+    words = [where] if isinstance(where, str) else list(where)
+    cp = model.pattern
+    V = np.asarray(model.X0, float)[: cp.n_vertices]
+    size = float(np.linalg.norm(np.ptp(V, axis=0))) or 1.0
+    eps = tol * size
+    keep = np.ones(len(V), bool)
+    for w in words:
+        if w == "all":
+            m = np.ones(len(V), bool)
+        elif w == "boundary":
+            m = np.zeros(len(V), bool)
+            m[cp.boundary_vertices] = True
+        elif w in _AXES:
+            ax, side = _AXES[w]
+            ext = V[:, ax].min() if side < 0 else V[:, ax].max()
+            m = np.abs(V[:, ax] - ext) <= eps
+        else:
+            raise ConfigError(
+                f"unknown vertex set {w!r}; expected all, boundary, {', '.join(_AXES)}"
+            )
+        keep &= m
+    return np.flatnonzero(keep)
+
+
+_AXES = {
+    "left": (0, -1),
+    "right": (0, 1),
+    "bottom": (1, -1),
+    "top": (1, 1),
+    "zmin": (2, -1),
+    "zmax": (2, 1),
+}
+
+
+def self_weight(model: Any, area_density: float, g: Any = (0.0, 0.0, -9.81)) -> np.ndarray:
+    """Nodal self-weight (n_nodes, 3): each facet's area times ``area_density`` times ``g``,
+    shared equally by its corner vertices (lumped; the total force is exact)."""
+    cp = model.pattern
+    X = np.asarray(model.X0, float)
+    F = np.zeros_like(X)
+    g = np.asarray(g, float).reshape(3)
+    for f in cp.faces:
+        P = X[list(f)]
+        area = 0.5 * np.linalg.norm(np.cross(P, np.roll(P, -1, axis=0)).sum(0))
+        F[list(f)] += area * area_density * g / len(f)
+    return F
+
+
+# ------------------------------------------------------------------------------ TOML
+_TOP_KEYS = {"name", "pattern", "model", "supports", "loads", "prescribed", "actuators", "solve"}
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read a scene from a TOML file (see ``data/scenes/*.toml`` and docs/solver.md)."""
+    path = Path(path)
+    try:
+        with path.open("rb") as fh:
+            data = tomllib.load(fh)
+    except FileNotFoundError:
+        raise ConfigError(f"scene file {str(path)!r} does not exist") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path.name}: invalid TOML: {exc}") from None
+    data.setdefault("name", path.stem)
+    return scene_from_dict(data, base_dir=path.parent)
+
+
+def _check_keys(d: dict[str, Any], allowed: set[str], where: str) -> None:
+    if not isinstance(d, dict):
+        raise ConfigError(f"[{where}] must be a table, got {type(d).__name__}")
+    for k in d:
+        if k not in allowed:
+            raise ConfigError(
+                f"unknown key {k!r} in [{where}]; expected one of {', '.join(sorted(allowed))}"
+            )
+
+
+def scene_from_dict(d: dict[str, Any], base_dir: str | Path = ".") -> Scene:
+    """Build a :class:`Scene` from the TOML mapping (unknown keys raise ConfigError)."""
+    _check_keys(d, _TOP_KEYS, "scene")
+    cp = _pattern_from(d.get("pattern"), Path(base_dir))
+    model = _model_from(cp, d.get("model", {}))
+    n = model.n_nodes
+    supports = None
+    if "supports" in d:
+        supports = np.zeros((n, 3), bool)
+        for i, g in enumerate(_groups(d["supports"], "supports")):
+            _check_keys(g, _SELECT | {"dofs"}, f"supports.{i}")
+            supports[np.ix_(_nodes(model, g, f"supports.{i}"), _dofs(g))] = True
+    loads = None
+    if "loads" in d:
+        loads = np.zeros((n, 3))
+        for i, g in enumerate(_groups(d["loads"], "loads")):
+            _check_keys(g, _SELECT | {"force", "self_weight"}, f"loads.{i}")
+            if "self_weight" in g:
+                sw = g["self_weight"]
+                _check_keys(sw, {"area_density", "g"}, f"loads.{i}.self_weight")
+                if "area_density" not in sw:
+                    raise ConfigError(f"[loads.{i}.self_weight] needs area_density")
+                loads += self_weight(model, float(sw["area_density"]), sw.get("g", (0, 0, -9.81)))
+            if "force" in g:
+                loads[_nodes(model, g, f"loads.{i}")] += _vec3(g["force"], f"loads.{i}.force")
+    prescribed = None
+    if "prescribed" in d:
+        prescribed = np.full((n, 3), np.nan)
+        for i, g in enumerate(_groups(d["prescribed"], "prescribed")):
+            _check_keys(g, _SELECT | {"displacement", "dofs"}, f"prescribed.{i}")
+            if "displacement" not in g:
+                raise ConfigError(f"[prescribed.{i}] needs displacement = [ux, uy, uz]")
+            u = _vec3(g["displacement"], f"prescribed.{i}.displacement")
+            idx, comps = _nodes(model, g, f"prescribed.{i}"), _dofs(g)
+            prescribed[np.ix_(idx, comps)] = u[comps]
+    actuators = None
+    if "actuators" in d:
+        a = d["actuators"]
+        _check_keys(a, {"edges", "targets_deg", "table_deg"}, "actuators")
+        edges = a.get("edges")
+        if isinstance(edges, str):
+            if edges != "creases":
+                raise ConfigError(f"actuators.edges = {edges!r}; expected a list or 'creases'")
+            edges = cp.crease_edges
+        if edges is None:
+            raise ConfigError("[actuators] needs edges")
+        actuators = Actuators(
+            edges=edges, targets_deg=a.get("targets_deg"), table_deg=a.get("table_deg")
+        )
+    solve = d.get("solve", {})
+    _check_keys(solve, {"steps", "control", "options"}, "solve")
+    return Scene(
+        model,
+        supports=supports,
+        loads=loads,
+        prescribed=prescribed,
+        actuators=actuators,
+        steps=int(solve.get("steps", 50)),
+        control=str(solve.get("control", "auto")),
+        options=SolverOptions.from_dict(solve.get("options")),
+        name=str(d.get("name", "scene")),
+    )
+
+
+CONTROLS: tuple[str, ...] = (*typing.get_args(ControlKind), "auto")
+_SELECT = {"vertices", "nodes", "edges", "where"}
+
+
+def _groups(v: Any, where: str) -> list[dict[str, Any]]:
+    if isinstance(v, dict):
+        return [v]
+    if isinstance(v, list) and all(isinstance(g, dict) for g in v):
+        return v
+    raise ConfigError(f"[{where}] must be a table or an array of tables ([[{where}]])")
+
+
+def _nodes(model: Any, g: dict[str, Any], where: str) -> np.ndarray:
+    """Node ids of a selection group (union of vertices, nodes, edges' end vertices, where)."""
+    n, cp = model.n_nodes, model.pattern
+    ids: list[np.ndarray] = []
+    if "vertices" in g:
+        v = np.asarray(g["vertices"], np.int64).ravel()
+        if v.size and (v.min() < 0 or v.max() >= cp.n_vertices):
+            raise ConfigError(f"[{where}] vertices must be in 0..{cp.n_vertices - 1}")
+        ids.append(v)
+    if "nodes" in g:
+        v = np.asarray(g["nodes"], np.int64).ravel()
+        if v.size and (v.min() < 0 or v.max() >= n):
+            raise ConfigError(f"[{where}] nodes must be in 0..{n - 1}")
+        ids.append(v)
+    if "edges" in g:
+        e = np.asarray(g["edges"], np.int64).ravel()
+        if e.size and (e.min() < 0 or e.max() >= cp.n_edges):
+            raise ConfigError(f"[{where}] edges must be in 0..{cp.n_edges - 1}")
+        ids.append(np.asarray(cp.edges)[e].ravel())
+    if "where" in g:
+        ids.append(select_vertices(model, g["where"]))
+    if not ids:
+        raise ConfigError(f"[{where}] selects nothing: give vertices, nodes, edges or where")
+    out = np.unique(np.concatenate(ids))
+    if out.size == 0:
+        raise ConfigError(f"[{where}] selects no node")
+    return out
+
+
+def _dofs(g: dict[str, Any]) -> list[int]:
+    s = str(g.get("dofs", "xyz")).lower()
+    if not s or any(c not in "xyz" for c in s):
+        raise ConfigError(f"dofs = {s!r}; expected letters from 'xyz'")
+    return sorted({"xyz".index(c) for c in s})
+
+
+def _vec3(v: Any, where: str) -> np.ndarray:
+    a = np.asarray(v, float).ravel()
+    if a.shape != (3,):
+        raise ConfigError(f"{where} must have 3 components, got {len(a)}")
+    return a
+
+
+def _pattern_from(p: Any, base: Path) -> Any:
+    if p is None:
+        raise ConfigError("the scene needs a [pattern] table (family = ... or file = ...)")
+    _check_keys(p, {"family", "file", "params", "frame"}, "pattern")
+    if ("family" in p) == ("file" in p):
+        raise ConfigError("[pattern] needs exactly one of family or file")
+    if "file" in p:
+        import barhinge as bh
+
+        f = Path(p["file"])
+        f = f if f.is_absolute() else base / f
+        if "frame" in p:
+            return bh.read_fold(f, frame=int(p["frame"]))
+        return bh.read(f)
+    from barhinge.patterns import FAMILIES
+
+    fam = p["family"]
+    if fam not in FAMILIES:
+        raise ConfigError(f"pattern family {fam!r} is unknown; expected one of {sorted(FAMILIES)}")
+    params = p.get("params", {})
+    gen = FAMILIES[fam]
+    sig = inspect.signature(gen)
+    for k in params:
+        if k not in sig.parameters:
+            raise ConfigError(
+                f"unknown key {k!r} in [pattern.params] of family {fam!r}; expected one of "
+                f"{', '.join(sig.parameters)}"
+            )
+    return gen(**params)
+
+
+def _model_from(cp: Any, m: dict[str, Any]) -> Any:
+    from barhinge.model.calibrate import Material
+    from barhinge.model.model import BarHingeModel
+
+    m = dict(m)
+    sig = inspect.signature(BarHingeModel.from_pattern)
+    allowed = (set(sig.parameters) - {"cls", "cp", "pattern", "material"}) | {"material"}
+    _check_keys(m, allowed, "model")
+    kw: dict[str, Any] = {}
+    if "material" in m:
+        mat = m.pop("material")
+        fields = {f.name for f in dataclasses.fields(Material)}
+        _check_keys(mat, fields, "model.material")
+        kw["material"] = Material(**mat)
+    kw.update(m)
+    return BarHingeModel.from_pattern(cp, **kw)
+
+
+# ------------------------------------------------------------------------------ default
+def default_scene(nx: int = 6, ny: int = 6, steps: int = 30) -> Scene:
+    """The built-in scene of ``barhinge fold``: a Miura-ori sheet folded by actuators.
+
+    A sheet of ``nx`` x ``ny`` cells (a = b = 1, sector angle 60 deg), N5B8 model with
+    fold stiffness 0.1 and stiff bars and panels, starting from the rigidly folded state at
+    facet angle 5 deg (just off the flat bifurcation point). The creases of one straight
+    crease line are actuated to their rigid-folding angles at facet angle 60 deg
+    (Schenk & Guest 2013); the rest of the sheet follows.
+    """
+    from barhinge.patterns import miura
+
+    cp0 = miura(nx, ny, a=1.0, b=1.0, alpha=60.0, fold=5.0)
+    cp1 = miura(nx, ny, a=1.0, b=1.0, alpha=60.0, fold=60.0)
+    model = _default_model(cp0)
+    edges = miura_line_creases(miura(nx, ny, a=1.0, b=1.0, alpha=60.0))
+    acts = Actuators(edges=edges, targets_deg=np.asarray(cp1.fold_angles)[edges])
+    return Scene(model, actuators=acts, steps=steps, name="miura-default")
+
+
+def _default_model(cp: Any) -> Any:
+    from barhinge.model.calibrate import Material
+    from barhinge.model.model import BarHingeModel
+
+    return BarHingeModel.from_pattern(
+        cp, scheme="N5B8", material=Material(E=1e6, nu=0.3, t=0.01), fold_stiffness=1e-3
+    )
+
+
+def miura_line_creases(cp: Any) -> np.ndarray:
+    """Edge ids of the M/V creases on the longest straight crease line through the vertex
+    nearest the centroid of a flat Miura sheet (edge ids are the same in folded states)."""
+    V = np.asarray(cp.vertices, float)
+    E = np.asarray(cp.edges)
+    crease = np.flatnonzero(np.isin(np.asarray(cp.assignment), ["M", "V"]))
+    c = int(np.argmin(np.linalg.norm(V - V.mean(0), axis=1)))
+    size = float(np.linalg.norm(np.ptp(V, axis=0)))
+    best = np.zeros(0, np.int64)
+    for e in crease[(E[crease] == c).any(1)]:
+        u = V[E[e, 1]] - V[E[e, 0]]
+        u /= np.linalg.norm(u)
+        # creases collinear with e: both end points on the line through c along u
+        ok = np.ones(len(crease), bool)
+        for k in (0, 1):
+            off = V[E[crease, k]] - V[c]
+            ok &= np.linalg.norm(off - np.outer(off @ u, u), axis=1) <= 1e-6 * size
+        line = crease[ok]
+        if len(line) > len(best):
+            best = line
+    return np.sort(best)

@@ -1,0 +1,557 @@
+"""Incremental Newton driver: fold-angle (actuator), displacement, load and arc-length control.
+
+One path parameter ``t`` goes from 0 to 1 over ``scene.steps`` requested steps. Each requested
+step may be split into smaller increments (cut-back on divergence, growth again after easy
+increments, never past the next requested step), so results land exactly on the steps. Every
+increment starts with a tangent predictor at the last converged state (the prescribed
+displacements and the new actuator targets enter linearised), then Newton iterations with the
+analytic tangent until both the force residual and the displacement correction are small.
+See :mod:`barhinge.solve.controls` for the bordered actuator system and docs/solver.md.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import time
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from barhinge.errors import ConfigError, ConvergenceError
+from barhinge.results import FoldPath
+from barhinge.solve.controls import (
+    BorderedSystem,
+    Timer,
+    actuator_terms,
+    gdcm_scale,
+    gdcm_sign,
+)
+from barhinge.solve.linear import SingularMatrixError, get_backend
+
+if TYPE_CHECKING:
+    from barhinge.scene import Scene
+
+__all__ = ["Progress", "solve"]
+
+log = logging.getLogger(__name__)
+
+#: progress callback: (requested steps done, total steps, path parameter or load factor)
+Progress = Callable[[int, int, float], None]
+
+
+@dataclasses.dataclass
+class _State:
+    x: np.ndarray  # (n_dof,) coordinates, flattened
+    mu: np.ndarray  # (n_act,) Lagrange multipliers (= -actuator moments)
+    lam: float  # load factor
+    t: float  # path parameter
+
+
+@dataclasses.dataclass
+class _Eval:
+    """Everything computed at one iterate."""
+
+    ev: Any
+    terms: Any
+    r: np.ndarray  # (n_dof,) f_int - lam P + G^T mu (all DOFs)
+    c: np.ndarray  # (n_act,) rho - target
+
+
+class _Failed(Exception):
+    def __init__(self, why: str, residuals: list[float]) -> None:
+        super().__init__(why)
+        self.why = why
+        self.residuals = residuals
+
+
+class _Driver:
+    def __init__(self, scene: Scene) -> None:
+        self.scene = scene
+        self.model = model = scene.model
+        self.opts = scene.options
+        self.X0 = np.asarray(model.X0, float)
+        self.n_dof = self.X0.size
+        self.fixed = scene.fixed.ravel()
+        self.free = ~self.fixed
+        if not self.free.any():
+            raise ConfigError("every DOF is fixed by supports or prescribed displacements")
+        self.P = scene.loads.ravel()
+        pres = scene.prescribed.ravel()
+        self.u_pres = np.where(np.isfinite(pres), pres, 0.0)
+        self.hinges = scene.actuator_hinges()
+        self.n_act = len(self.hinges)
+        self.schedule = np.radians(scene.actuator_schedule_deg())  # (steps+1, n_act)
+        self.timer = Timer()
+        ext = np.ptp(self.X0, axis=0)
+        self.size = float(np.linalg.norm(ext)) or 1.0
+        self.backend = get_backend(self.opts.linear_solver)
+        terms0 = actuator_terms(model, self.X0, self.hinges)
+        self.system = BorderedSystem(self.backend, self.free, terms0.dofs, self.timer)
+        self.force_floor = self.opts.force_floor
+        self.penalty: float | None = None
+        self.records: list[dict[str, Any]] = []
+        self.t_start = time.perf_counter()
+        self.work = 0.0
+        self._last_sub: dict[str, Any] | None = None
+        self._prev: _State | None = None
+        self.c_scale = 1.0
+        self.n_fact_last = 0
+        self._inertia: int | None = None
+        self.system.track_inertia = scene.control == "load"
+
+    # ------------------------------------------------------------ schedules
+    def targets(self, t: float) -> np.ndarray:
+        """Actuator target angles (rad) at path parameter t (linear between rows)."""
+        if not self.n_act:
+            return np.zeros(0)
+        s = t * self.scene.steps
+        i = min(int(np.floor(s)), self.scene.steps - 1)
+        f = s - i
+        return (1 - f) * self.schedule[i] + f * self.schedule[i + 1]
+
+    def fixed_coords(self, t: float) -> np.ndarray:
+        return self.X0.ravel()[self.fixed] + t * self.u_pres[self.fixed]
+
+    # ------------------------------------------------------------ evaluation
+    def evaluate(self, st: _State) -> _Eval:
+        t0 = time.perf_counter()
+        X = st.x.reshape(-1, 3)
+        ev = self.model.evaluate(X, tangent=True)
+        terms = actuator_terms(self.model, X, self.hinges)
+        self.timer.assembly += time.perf_counter() - t0
+        r = np.asarray(ev.force, float).ravel() - st.lam * self.P
+        if self.n_act:
+            r = r + terms.G.T @ st.mu
+        c = terms.rho - self.targets(st.t) if self.n_act else np.zeros(0)
+        if self.n_act:
+            c = (c + np.pi) % (2 * np.pi) - np.pi
+        if self.force_floor is None:
+            d = np.abs(ev.K.diagonal())
+            self.force_floor = 1e-9 * float(d.max() if d.size else 1.0) * self.size
+        if self.penalty is None:
+            self.penalty = self._auto_penalty(ev.K, terms)
+        return _Eval(ev, terms, r, c)
+
+    def _auto_penalty(self, K, terms) -> float:
+        a = self.opts.augmentation
+        self.c_scale = 1.0
+        d = np.abs(K.diagonal())
+        if not self.n_act:
+            return 0.0
+        dd = d[terms.dofs.ravel()]
+        kd = float(np.mean(dd)) if dd.size and np.mean(dd) > 0 else 1.0
+        g2 = float(np.mean(np.sum(terms.grad**2, axis=1)))
+        self.c_scale = kd / np.sqrt(g2) if g2 > 0 else kd
+        if a != "auto":
+            return float(a)
+        return kd / g2 if g2 > 0 else kd
+
+    def factorize(self, e: _Eval, st: _State) -> None:
+        self.system.factorize(e.ev.K, e.terms, st.mu, self.penalty or 0.0)
+
+    def force_ref(self, e: _Eval, st: _State) -> float:
+        """Force scale of the convergence test."""
+        parts = [float(np.linalg.norm(st.lam * self.P)), float(self.force_floor)]
+        f = np.asarray(e.ev.force, float).ravel()
+        parts.append(float(np.linalg.norm(f[self.fixed])) if self.fixed.any() else 0.0)
+        if self.n_act:
+            parts.append(float(np.linalg.norm(e.terms.G.T @ st.mu)))
+        return max(parts)
+
+    def converged(self, e: _Eval, st: _State, dx: np.ndarray, res: list[float]) -> bool:
+        o = self.opts
+        rf = float(np.linalg.norm(e.r[self.free]))
+        ok_f = rf <= o.tol_force * self.force_ref(e, st) + self.force_floor
+        ok_x = float(np.linalg.norm(dx)) <= o.tol_disp * self.size
+        if not ok_x and len(res) >= 2 and rf < 1e-3 * res[-2]:
+            ok_x = True
+        ok_c = (not self.n_act) or float(np.max(np.abs(e.c))) <= o.tol_angle
+        return ok_f and ok_x and ok_c
+
+    # ------------------------------------------------------------ one increment
+    def increment(self, st: _State, t1: float, lam1: float) -> tuple[_State, _Eval, list[float]]:
+        """Newton from the converged state ``st`` to path parameter t1 (load factor lam1).
+
+        Predictor: secant extrapolation of the last two converged states when there are two
+        (second-order accurate along a smoothly curving fold path), otherwise a tangent step
+        at ``st`` with the prescribed displacements and new targets linearised. Correctors:
+        Newton with the analytic tangent and a backtracking line search on the merit
+        ``|r_free|^2 + (s c)^2`` (full steps near the solution, so the rate stays quadratic).
+        """
+        o = self.opts
+        free, fixed = self.free, self.fixed
+        res: list[float] = []
+        self.system.inertia_seen = []
+        prev = self._prev
+        if prev is not None and prev.t < st.t and o.predictor == "secant":
+            f = (t1 - st.t) / (st.t - prev.t)
+            new = _State(st.x + f * (st.x - prev.x), st.mu + f * (st.mu - prev.mu), lam1, t1)
+            new.x[fixed] = self.fixed_coords(t1)
+            n_fact = 0
+        else:
+            e = self.evaluate(st)
+            du_c = self.fixed_coords(t1) - st.x[fixed]
+            rhs = -(e.r - (lam1 - st.lam) * self.P)
+            if du_c.size and np.any(du_c):
+                dfull = np.zeros(self.n_dof)
+                dfull[fixed] = du_c
+                rhs = rhs - e.ev.K @ dfull
+            c_pred = e.c + (self.targets(st.t) - self.targets(t1)) if self.n_act else e.c
+            self._factorize_or_fail(e, st, res)
+            dx, dmu = self.system.solve(rhs[free], -c_pred)
+            new = _State(st.x.copy(), st.mu + dmu, lam1, t1)
+            new.x[free] += dx
+            new.x[fixed] = self.fixed_coords(t1)
+            n_fact = 1
+        x_pred = new.x.copy()
+        e = self.evaluate(new)
+        dx_last: np.ndarray | None = None
+        while True:
+            rf = float(np.linalg.norm(e.r[free]))
+            res.append(rf)
+            self.timer.n_iterations += 1
+            if not np.isfinite(rf) or not np.all(np.isfinite(e.c)):
+                raise _Failed("non-finite residual", res)
+            if dx_last is not None and self.converged(e, new, dx_last, res):
+                self.n_fact_last = n_fact
+                self._check_inertia(res)
+                self._check_jump(st, x_pred, new, res)
+                return new, e, res
+            if n_fact >= o.max_iter:
+                raise _Failed(f"no convergence in {o.max_iter} iterations", res)
+            if len(res) > 2 and rf > o.divergence_ratio * max(res[0], self.force_floor):
+                raise _Failed("residual diverged", res)
+            self._factorize_or_fail(e, new, res)
+            n_fact += 1
+            dx, dmu = self.system.solve(-e.r[free], -e.c)
+            new, e, alpha = self._line_search(new, e, dx, dmu)
+            dx_last = alpha * dx
+
+    def _check_inertia(self, res: list[float]) -> None:
+        """Under load control an increment must not cross a critical point: the number of
+        negative pivots of the tangent (its negative eigenvalues) must not change. A change
+        means a limit point (or bifurcation) lies inside the increment and Newton jumped to
+        another branch; the increment is rejected (and cut back until the cap)."""
+        sysm = self.system
+        if not sysm.track_inertia:
+            return
+        seen = [n for n in sysm.inertia_seen if n is not None]
+        sysm.inertia_seen = []
+        if self._inertia is None and seen:
+            self._inertia = seen[0]
+        bad = [n for n in seen if n != self._inertia]
+        if bad:
+            raise _Failed(
+                f"limit point: the tangent's negative eigenvalues went from {self._inertia} to "
+                f"{bad[0]} inside the increment (use control = 'arc_length' to pass it)", res
+            )
+
+    def _check_jump(self, st: _State, x_pred: np.ndarray, new: _State, res: list[float]) -> None:
+        """Under load control the Newton correction must stay smaller than the predictor
+        step (``|x - x_pred| <= |x_pred - x_start|``); a larger one means Newton left the
+        branch (snapped over a limit point to a distant equilibrium)."""
+        if not self.system.track_inertia:
+            return
+        step = float(np.linalg.norm(x_pred - st.x))
+        corr = float(np.linalg.norm(new.x - x_pred))
+        if corr > step + self.opts.tol_disp * self.size:
+            raise _Failed(
+                f"limit point: Newton left the branch (correction {corr:.3g} > predictor step "
+                f"{step:.3g}; use control = 'arc_length' to pass it)", res
+            )
+
+    def _merit(self, e: _Eval) -> float:
+        return float(e.r[self.free] @ e.r[self.free]) + float((self.c_scale * e.c) @ e.c
+                                                              * self.c_scale)
+
+    def _line_search(self, st: _State, e: _Eval, dx: np.ndarray, dmu: np.ndarray):
+        """Backtracking (Armijo) on the merit function; the trial evaluation is reused."""
+        phi0 = self._merit(e)
+        alpha = 1.0
+        for k in range(self.opts.line_search + 1):
+            trial = _State(st.x.copy(), st.mu + alpha * dmu, st.lam, st.t)
+            trial.x[self.free] += alpha * dx
+            et = self.evaluate(trial)
+            phi = self._merit(et)
+            if (np.isfinite(phi) and phi <= (1 - 1e-4 * alpha) * phi0) or k == self.opts.line_search:
+                return trial, et, alpha
+            alpha *= 0.5
+        raise AssertionError("unreachable")
+
+    def _factorize_or_fail(self, e: _Eval, st: _State, res: list[float]) -> None:
+        try:
+            self.factorize(e, st)
+        except SingularMatrixError as exc:
+            raise _Failed(f"singular tangent ({exc})", res) from None
+
+    # ------------------------------------------------------------ records
+    def record(self, st: _State, e: _Eval, iters: int, res: list[float]) -> None:
+        X = st.x.reshape(-1, 3)
+        ev = e.ev
+        R = np.zeros(self.n_dof)
+        R[self.fixed] = e.r[self.fixed]  # f_int + G^T mu - lam P at supports
+        moments = -st.mu
+        self.records.append(
+            {
+                "X": X.copy(),
+                "fold": np.asarray(self.model.crease_fold_angles_deg(X), float),
+                "targets": np.degrees(self.targets(st.t)),
+                "moments": moments.copy(),
+                "rho": e.terms.rho.copy(),
+                "eb": float(ev.energy_bars),
+                "ebend": float(ev.energy_bend),
+                "efold": float(ev.energy_fold),
+                "R": R.reshape(-1, 3),
+                "lam": st.lam,
+                "iters": iters,
+                "res": tuple(res),
+                "wall": time.perf_counter() - self.t_start,
+                "work": self.work,
+            }
+        )
+
+    def add_work(self, prev: dict[str, Any], st: _State, e: _Eval) -> None:
+        """Trapezoidal work of loads, support reactions and actuators over one increment."""
+        x0 = prev["X"].ravel()
+        f0 = prev["lam"] * self.P + prev["R"].ravel()
+        R1 = np.zeros(self.n_dof)
+        R1[self.fixed] = e.r[self.fixed]
+        f1 = st.lam * self.P + R1
+        w = 0.5 * float((f0 + f1) @ (st.x - x0))
+        if self.n_act:
+            w += 0.5 * float((prev["moments"] + (-st.mu)) @ (e.terms.rho - prev["rho"]))
+        self.work += w
+
+    def path(self, converged: bool = True, message: str = "") -> FoldPath:
+        rec = self.records
+        acts = self.scene.actuators
+        edges = acts.edges if acts is not None else np.zeros(0, np.int64)
+        meta = {
+            "scene": self.scene.name,
+            "control": self.scene.control,
+            "steps": self.scene.steps,
+            "scheme": str(getattr(self.model, "scheme", "")),
+            "n_dof": int(self.n_dof),
+            "n_free": int(self.free.sum()),
+            "linear_solver": self.backend.name,
+            "auto_restrained": bool(self.scene.auto_restrained),
+            "timing": self.timer.as_dict(),
+        }
+        return FoldPath(
+            X=np.stack([r["X"] for r in rec]),
+            fold_angles_deg=np.stack([r["fold"] for r in rec]),
+            actuator_edges=edges,
+            actuator_targets_deg=np.stack([r["targets"] for r in rec]).reshape(len(rec), -1),
+            actuator_moments=np.stack([r["moments"] for r in rec]).reshape(len(rec), -1),
+            energy_bars=np.array([r["eb"] for r in rec]),
+            energy_bend=np.array([r["ebend"] for r in rec]),
+            energy_fold=np.array([r["efold"] for r in rec]),
+            reactions=np.stack([r["R"] for r in rec]),
+            load_factor=np.array([r["lam"] for r in rec]),
+            iterations=np.array([r["iters"] for r in rec]),
+            residual_norms=tuple(r["res"] for r in rec),
+            wall_time=np.array([r["wall"] for r in rec]),
+            external_work=np.array([r["work"] for r in rec]),
+            converged=converged,
+            message=message,
+            kind="bar-hinge",
+            meta=meta,
+        )
+
+    def fail(self, step: int, lam: float, why: str, res: list[float]) -> ConvergenceError:
+        msg = (
+            f"step {step} of {self.scene.steps} did not converge at load factor {lam:.6g} "
+            f"after {self.opts.max_cutbacks} cut-backs ({why})"
+        )
+        return ConvergenceError(
+            msg, step=step, load_factor=lam, residuals=res,
+            last_state=self.path(converged=False, message=msg),
+        )
+
+    # ------------------------------------------------------------ state 0
+    def initial(self) -> tuple[_State, _Eval]:
+        st = _State(self.X0.ravel().copy(), np.zeros(self.n_act), 0.0, 0.0)
+        e = self.evaluate(st)
+        if self.n_act:
+            # multipliers that balance the initial state best (zero for a stress-free start)
+            G = e.terms.G[:, self.free]
+            rf = e.r[self.free]
+            mu, *_ = np.linalg.lstsq(G.T.toarray(), -rf, rcond=None)
+            st.mu = mu
+            e = self.evaluate(st)
+        return st, e
+
+    # ------------------------------------------------------------ drivers
+    def run_parameter(self, progress: Progress | None) -> FoldPath:
+        """Fold-angle, displacement and load control: t (= load factor) from 0 to 1."""
+        o = self.opts
+        steps = self.scene.steps
+        st, e = self.initial()
+        self.record(st, e, 0, [])
+        h0 = 1.0 / steps
+        h = h0
+        h_min = h0 * 0.5**o.max_cutbacks
+        for s in range(1, steps + 1):
+            t_goal = s / steps
+            iters, res_all = 0, []
+            while st.t < t_goal - 1e-12 * h0:
+                h_try = min(h, t_goal - st.t)
+                t1 = t_goal if h_try >= t_goal - st.t - 1e-12 * h0 else st.t + h_try
+                try:
+                    new, e_new, res = self.increment(st, t1, t1)
+                except _Failed as f:
+                    log.debug("step %d: increment to t=%.6g failed (%s); cutting back", s, t1,
+                              f.why)
+                    h = h_try / 2
+                    if h < h_min * (1 - 1e-9):
+                        raise self.fail(s, st.lam, f.why, f.residuals) from None
+                    continue
+                self._work_step(new, e_new)
+                self._prev, st = st, new
+                self._inertia = self.system.negative_pivots
+                iters += self.n_fact_last
+                res_all.extend(res)
+                if self.n_fact_last <= o.grow_iters:
+                    h = min(2 * h_try, h0)
+            self.record(st, e_new, iters, res_all)
+            if progress is not None:
+                progress(s, steps, st.t)
+        return self.path()
+
+    def _work_step(self, new: _State, e_new: _Eval) -> None:
+        """Add the work of the increment ending at ``new`` (from the last converged
+        increment, which may lie between requested steps)."""
+        last = self._last_sub if self._last_sub is not None else self.records[-1]
+        self.add_work(last, new, e_new)
+        R = np.zeros(self.n_dof)
+        R[self.fixed] = e_new.r[self.fixed]
+        self._last_sub = {
+            "X": new.x.reshape(-1, 3).copy(),
+            "lam": new.lam,
+            "R": R.reshape(-1, 3),
+            "moments": -new.mu,
+            "rho": e_new.terms.rho.copy(),
+        }
+
+    def run_arc_length(self, progress: Progress | None) -> FoldPath:
+        """MGDCM arc length (Leon et al. 2011): states at every increment until the load
+        factor reaches 1 (the last state is corrected to exactly 1 by load control)."""
+        o = self.opts
+        steps = self.scene.steps
+        max_steps = o.max_arc_steps or 10 * steps
+        dl0 = o.arc_length_increment or 1.0 / steps
+        st, e = self.initial()
+        self.record(st, e, 0, [])
+        first_tan: np.ndarray | None = None
+        prev_tan: np.ndarray | None = None
+        sign = 1.0
+        free = self.free
+        n = 0
+        while st.lam < 1.0 - 1e-12 and n < max_steps:
+            n += 1
+            scale = dl0
+            for _cut in range(o.max_cutbacks + 1):
+                try:
+                    new, e_new, res, tan, sgn = self._arc_increment(
+                        st, scale, first_tan, prev_tan, sign
+                    )
+                    break
+                except _Failed as f:
+                    scale /= 2
+                    last = f
+            else:
+                raise self.fail(n, st.lam, last.why, last.residuals)
+            if first_tan is None:
+                first_tan = tan
+            prev_tan, sign = tan, sgn
+            self._work_step(new, e_new)
+            if new.lam > 1.0 and st.lam < 1.0:
+                # land exactly on lambda = 1 by load control from the last state
+                try:
+                    fin, e_fin, res2 = self.increment(st, st.t, 1.0)
+                    self._last_sub = self.records[-1]
+                    self.work = self.records[-1]["work"]
+                    self._work_step(fin, e_fin)
+                    new, e_new, res = fin, e_fin, res2
+                except _Failed:
+                    pass
+            st = new
+            self.record(st, e_new, len(res) + 1, res)
+            if progress is not None:
+                progress(min(int(st.lam * steps), steps), steps, st.lam)
+        return self.path()
+
+    def _arc_increment(self, st, dl0, first_tan, prev_tan, sign):
+        """One MGDCM increment: predictor with the GSP-scaled load increment, correctors
+        with ``dlambda = -(du_1 . du_bar)/(du_1 . du_hat)`` (Leon et al. 2011)."""
+        o = self.opts
+        free = self.free
+        res: list[float] = []
+        e = self.evaluate(st)
+        try:
+            self.factorize(e, st)
+        except SingularMatrixError as exc:
+            raise _Failed(f"singular tangent ({exc})", res) from None
+        zc = np.zeros(self.n_act)
+        u_hat, mu_hat = self.system.solve(self.P[free], zc)
+        sgn = gdcm_sign(prev_tan, u_hat, sign)
+        base = first_tan if first_tan is not None else u_hat
+        dlam = sgn * dl0 * gdcm_scale(base, prev_tan, u_hat)
+        u_bar, mu_bar = self.system.solve(-e.r[free], -e.c)
+        new = _State(st.x.copy(), st.mu + dlam * mu_hat + mu_bar, st.lam + dlam, st.t)
+        dx = dlam * u_hat + u_bar
+        new.x[free] += dx
+        tan1 = u_hat
+        it = 1
+        while True:
+            e = self.evaluate(new)
+            rf = float(np.linalg.norm(e.r[free]))
+            res.append(rf)
+            self.timer.n_iterations += 1
+            if not np.isfinite(rf):
+                raise _Failed("non-finite residual", res)
+            if it > 1 and self.converged(e, new, dx, res):
+                return new, e, res, tan1, sgn
+            if it >= o.max_iter:
+                raise _Failed(f"no convergence in {o.max_iter} iterations", res)
+            try:
+                self.factorize(e, new)
+            except SingularMatrixError as exc:
+                raise _Failed(f"singular tangent ({exc})", res) from None
+            uh, mh = self.system.solve(self.P[free], zc)
+            ub, mb = self.system.solve(-e.r[free], -e.c)
+            dl = -float(tan1 @ ub) / float(tan1 @ uh)
+            dx = dl * uh + ub
+            new.x[free] += dx
+            new.mu = new.mu + dl * mh + mb
+            new.lam += dl
+            it += 1
+
+
+def solve(scene: Scene, progress: Progress | None = None) -> FoldPath:
+    """Solve a scene along its path; returns a :class:`~barhinge.results.FoldPath`.
+
+    Parameters
+    ----------
+    scene : Scene
+    progress : callable (done, total, value) -> None, optional
+        Called after every requested step (value = path parameter or load factor).
+
+    Returns
+    -------
+    FoldPath with ``kind="bar-hinge"``: states 0..steps (every increment under arc length),
+    actuator moments (positive = driving the crease towards valley), reactions (force of
+    the supports on the structure), energies, external work, iterations, residual norms.
+
+    Raises
+    ------
+    ConvergenceError
+        When a step does not converge after ``options.max_cutbacks`` halvings; its
+        ``last_state`` is the partial FoldPath of the converged steps.
+    """
+    d = _Driver(scene)
+    if scene.control == "arc_length":
+        return d.run_arc_length(progress)
+    return d.run_parameter(progress)

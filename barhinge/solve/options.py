@@ -1,0 +1,108 @@
+"""Solver options (tolerances, step control, linear backend)."""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+from barhinge.errors import ConfigError
+
+__all__ = ["SolverOptions"]
+
+
+@dataclasses.dataclass(frozen=True)
+class SolverOptions:
+    """Options of :func:`barhinge.solve`.
+
+    Attributes
+    ----------
+    tol_force : float
+        Relative force tolerance: ``|R_free| <= tol_force * F_ref`` where ``F_ref`` is the
+        largest of the applied loads, the support reactions, the actuator forces ``G^T mu``
+        and ``force_floor``.
+    tol_disp : float
+        Relative displacement tolerance: ``|dx| <= tol_disp * size`` (``size`` = the model's
+        bounding-box diagonal) on the last correction. It is also taken as met when the
+        force residual fell by more than ``1e3`` in the last iteration (quadratic regime:
+        the next correction would be far below the tolerance).
+    tol_angle : float
+        Absolute tolerance on the actuator constraints ``|rho_a - rho_target|`` (radians).
+    force_floor : float or None
+        Absolute force scale below which residuals count as zero (default: ``1e-9`` times the
+        largest diagonal entry of the first tangent times ``size``).
+    max_iter : int
+        Newton iterations per increment before the increment is cut back.
+    max_cutbacks : int
+        How many times an increment may be halved (the smallest increment is
+        ``2**-max_cutbacks`` of a requested step); beyond that the solve raises
+        :class:`~barhinge.errors.ConvergenceError`.
+    grow_iters : int
+        An increment that converged in at most this many iterations lets the next one double
+        (never beyond the next requested step, so results land exactly on the steps).
+    divergence_ratio : float
+        Cut back when the residual grows by this factor over the increment's first residual.
+    linear_solver : str
+        ``"auto"``, ``"superlu"``, ``"cholmod"`` or ``"pardiso"`` (see ``solve.linear``).
+    augmentation : float or "auto"
+        Penalty ``p`` of the augmented-Lagrangian form ``K + p G^T G`` used to factorise the
+        bordered actuator system (exact: the term is compensated on the right-hand side).
+        ``"auto"`` scales it to the tangent; 0 disables it.
+    predictor : str
+        ``"secant"`` (extrapolate the last two converged states; tangent step for the first
+        increment) or ``"tangent"`` (always a linearised step at the last converged state).
+    line_search : int
+        Maximum halvings of a Newton correction in the backtracking line search on
+        ``|r|^2 + (s c)^2`` (0 = plain Newton, the default: on stiff-bar / soft-fold
+        mechanisms full Newton steps with cut-back of the increment were measured faster).
+    arc_length_increment : float or None
+        Load-factor increment of the first arc-length (MGDCM) step; default ``1/steps``.
+    max_arc_steps : int or None
+        Cap on arc-length increments (default ``10 * steps``).
+    """
+
+    tol_force: float = 1e-8
+    tol_disp: float = 1e-8
+    tol_angle: float = 1e-10
+    force_floor: float | None = None
+    max_iter: int = 25
+    max_cutbacks: int = 8
+    grow_iters: int = 4
+    divergence_ratio: float = 1e4
+    linear_solver: str = "auto"
+    augmentation: float | str = "auto"
+    predictor: str = "secant"
+    line_search: int = 0
+    arc_length_increment: float | None = None
+    max_arc_steps: int | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("tol_force", "tol_disp", "tol_angle", "divergence_ratio"):
+            v = getattr(self, name)
+            if not (isinstance(v, int | float) and v > 0):
+                raise ConfigError(f"solver option {name} = {v!r}; expected a positive number")
+        for name in ("max_iter", "grow_iters"):
+            v = getattr(self, name)
+            if not (isinstance(v, int) and v >= 1):
+                raise ConfigError(f"solver option {name} = {v!r}; expected an integer >= 1")
+        if not (isinstance(self.max_cutbacks, int) and self.max_cutbacks >= 0):
+            raise ConfigError(f"solver option max_cutbacks = {self.max_cutbacks!r}; expected >= 0")
+        if self.predictor not in ("secant", "tangent"):
+            raise ConfigError(f"solver option predictor = {self.predictor!r}; "
+                              "expected 'secant' or 'tangent'")
+        if not (isinstance(self.line_search, int) and self.line_search >= 0):
+            raise ConfigError(f"solver option line_search = {self.line_search!r}; expected >= 0")
+        a = self.augmentation
+        if not (a == "auto" or (isinstance(a, int | float) and a >= 0)):
+            raise ConfigError(f"solver option augmentation = {a!r}; expected 'auto' or >= 0")
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any] | None) -> SolverOptions:
+        """Options from a mapping (TOML ``[solve.options]``); unknown keys are errors."""
+        d = dict(d or {})
+        names = {f.name for f in dataclasses.fields(cls)}
+        for k in d:
+            if k not in names:
+                raise ConfigError(
+                    f"unknown solver option {k!r}; expected one of {', '.join(sorted(names))}"
+                )
+        return cls(**d)

@@ -1,0 +1,101 @@
+"""Writing a solved fold path to a folder: the FoldPath (npz), a summary (JSON and CSV).
+
+Other modules add files (pictures, VTU series) by appending a function to
+:data:`OUTPUT_HOOKS`; :func:`write_outputs` calls each hook after its own files.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import logging
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from barhinge.results import FoldPath
+
+__all__ = ["OUTPUT_HOOKS", "summary", "write_outputs"]
+
+log = logging.getLogger(__name__)
+
+#: extra writers: ``hook(path, scene, out_dir) -> list of written files``
+OUTPUT_HOOKS: list[Callable[[FoldPath, Any, Path], list[Path]]] = []
+
+
+def _results_hook(path: FoldPath, scene: Any, out_dir: Path) -> list[Path]:
+    """Result files (XDMF/VTU, FOLD frames, CSV/JSON) and pictures: barhinge.plot."""
+    from barhinge.plot import fold_outputs_hook
+
+    return fold_outputs_hook(path, scene, out_dir)
+
+
+OUTPUT_HOOKS.append(_results_hook)
+
+
+def summary(path: FoldPath, scene: Any = None) -> dict[str, Any]:
+    """A JSON-serialisable summary of a fold path (final state and totals)."""
+    last = path.n_states - 1
+    out: dict[str, Any] = {
+        "scene": path.meta.get("scene", getattr(scene, "name", "")),
+        "control": path.meta.get("control"),
+        "converged": bool(path.converged),
+        "message": path.message,
+        "n_states": int(path.n_states),
+        "n_nodes": int(path.X.shape[1]),
+        "n_dof": path.meta.get("n_dof"),
+        "linear_solver": path.meta.get("linear_solver"),
+        "wall_time_s": float(path.wall_time[last]) if path.n_states else 0.0,
+        "newton_iterations": int(np.sum(path.iterations)),
+        "load_factor": float(path.load_factor[last]),
+        "energy": {
+            "bars": float(path.energy_bars[last]),
+            "bend": float(path.energy_bend[last]),
+            "fold": float(path.energy_fold[last]),
+            "total": float(path.energy[last]),
+            "external_work": float(path.external_work[last]),
+        },
+        "actuators": {
+            "edges": path.actuator_edges.tolist(),
+            "angle_deg": (
+                path.fold_angles_deg[last][path.actuator_edges].tolist()
+                if len(path.actuator_edges)
+                else []
+            ),
+            "moment": path.actuator_moments[last].tolist(),
+        },
+        "timing": path.meta.get("timing", {}),
+    }
+    if path.reactions is not None:
+        out["reaction_sum"] = path.reactions[last].sum(axis=0).tolist()
+    return out
+
+
+def write_outputs(path: FoldPath, scene: Any, out_dir: str | Path) -> list[Path]:
+    """Write ``fold_path.npz``, ``summary.json`` and ``states.csv`` into ``out_dir`` (created),
+    then every :data:`OUTPUT_HOOKS` writer. Returns the written files."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    files = [path.save(out / "fold_path.npz")]
+    js = out / "summary.json"
+    js.write_text(json.dumps(summary(path, scene), indent=2) + "\n")
+    files.append(js)
+    cs = out / "states.csv"
+    with cs.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        names = [f"actuator_{e}_moment" for e in path.actuator_edges]
+        w.writerow(["state", "load_factor", "iterations", "energy_bars", "energy_bend",
+                    "energy_fold", "external_work", "wall_time", *names])
+        for i in range(path.n_states):
+            w.writerow([i, path.load_factor[i], path.iterations[i], path.energy_bars[i],
+                        path.energy_bend[i], path.energy_fold[i], path.external_work[i],
+                        path.wall_time[i], *path.actuator_moments[i].tolist()])
+    files.append(cs)
+    for hook in OUTPUT_HOOKS:
+        try:
+            files.extend(hook(path, scene, out))
+        except Exception as exc:  # an optional extra must not lose the solved path
+            log.warning("output hook %s failed: %s", getattr(hook, "__name__", hook), exc)
+    return files

@@ -1,0 +1,571 @@
+"""Parameter sweeps: map a function over a grid, serially, on a local Dask cluster or a remote one.
+
+A study (``STUDY.toml``) names a point function ``"module:function"`` and a parameter grid::
+
+    [study]
+    name = "demo"
+    function = "mypkg.points:run"   # called as run(**params), returns a small JSON-able dict
+    paths = ["."]                   # folders put on sys.path (client and workers) for the import
+    out = "results/demo"            # output folder (relative to the TOML file)
+    batch_size = 1                  # points per task (batch points shorter than ~0.1 s)
+
+    [grid]                          # the Cartesian product of these lists
+    spacing = [1.0, 2.0]
+    kappa = [0.0, 0.1, 0.2]
+
+    [fixed]                         # passed to every point (part of its identity)
+    steps = 20
+
+    [[points]]                      # extra explicit points (merged with [fixed])
+    spacing = 3.0
+    kappa = 0.5
+
+Output folder::
+
+    points/<id>.json    one record per finished point (written by the client, atomically)
+    summary.csv         one row per point of the study (summary.parquet too if pyarrow exists)
+    study.json          the study that produced them
+
+A point's identity is a stable hash of its parameters (:func:`point_id`). A rerun skips the
+points that already have a record (``retry_failed=True`` reruns the failed ones), so an
+interrupted sweep resumes where it stopped. The client is the only writer and keys records by
+point id, so a point that Dask re-executes after a worker died still yields exactly one record.
+A point that raises records ``{"type", "message"}`` and the sweep goes on.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import dataclasses
+import datetime as _dt
+import hashlib
+import importlib
+import itertools
+import json
+import logging
+import os
+import socket
+import sys
+import time
+import tomllib
+import uuid
+from collections.abc import Callable, Iterator, Sequence
+from pathlib import Path
+from typing import Any, Literal
+
+from barhinge.errors import ConfigError
+
+__all__ = [
+    "Point",
+    "Study",
+    "SweepReport",
+    "load_study",
+    "point_id",
+    "read_records",
+    "run_batch",
+    "run_study",
+    "write_summary",
+]
+
+log = logging.getLogger(__name__)
+
+Mode = Literal["serial", "local", "dask"]
+Record = dict[str, Any]
+
+_STUDY_KEYS = {"name", "function", "paths", "out", "batch_size"}
+_TOP_KEYS = {"study", "grid", "fixed", "points"}
+_RESERVED = ("id", "status", "error_type", "error_message", "elapsed_s", "worker")
+
+
+# ------------------------------------------------------------------------------ identity
+def _json_default(o: object) -> object:
+    if hasattr(o, "tolist"):  # numpy arrays and scalars
+        return o.tolist()
+    if isinstance(o, Path):
+        return str(o)
+    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+
+
+def _canonical(params: dict[str, Any]) -> str:
+    return json.dumps(params, sort_keys=True, separators=(",", ":"), default=_json_default)
+
+
+def point_id(params: dict[str, Any]) -> str:
+    """Stable identity of a parameter point: 16 hex digits of SHA-256 of its canonical JSON.
+
+    Key order does not matter; value types do (``1`` and ``1.0`` are different points).
+    """
+    return hashlib.sha256(_canonical(params).encode()).hexdigest()[:16]
+
+
+@dataclasses.dataclass(frozen=True)
+class Point:
+    """One parameter point: ``id`` = :func:`point_id` of ``params``."""
+
+    id: str
+    params: dict[str, Any]
+
+
+# ------------------------------------------------------------------------------ study
+@dataclasses.dataclass(frozen=True)
+class Study:
+    """A point function mapped over a parameter grid.
+
+    Parameters
+    ----------
+    function : str
+        ``"module:function"``; called as ``function(**params)``, returns a dict of JSON-able
+        values (numpy arrays and scalars are converted).
+    grid : dict of lists
+        Cartesian product, in the order given (the last key varies fastest).
+    fixed : dict
+        Parameters added to every point.
+    points : sequence of dicts
+        Explicit extra points (merged with ``fixed``).
+    name, out : study name and output folder.
+    batch_size : int
+        Points per task on a cluster.
+    paths : sequence of str
+        Absolute folders put on ``sys.path`` before importing ``function`` (also on workers,
+        which must see the same file system).
+    """
+
+    function: str
+    grid: dict[str, list[Any]] = dataclasses.field(default_factory=dict)
+    fixed: dict[str, Any] = dataclasses.field(default_factory=dict)
+    points: tuple[dict[str, Any], ...] = ()
+    name: str = "study"
+    out: Path | None = None
+    batch_size: int = 1
+    paths: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.function, str) or self.function.count(":") != 1:
+            raise ConfigError(f"study function must be 'module:function', got {self.function!r}")
+        for k, v in self.grid.items():
+            if not isinstance(v, list) or not v:
+                raise ConfigError(f"grid entry {k!r} must be a non-empty list, got {v!r}")
+        if not isinstance(self.batch_size, int) or self.batch_size < 1:
+            raise ConfigError(f"batch_size must be an integer >= 1, got {self.batch_size!r}")
+
+    def expand(self) -> list[Point]:
+        """All points: the grid product then the explicit points; repeats dropped."""
+        rows: list[dict[str, Any]] = []
+        if self.grid:
+            keys = list(self.grid)
+            rows += [
+                dict(zip(keys, vals, strict=True))
+                for vals in itertools.product(*self.grid.values())
+            ]
+        rows += [dict(p) for p in self.points]
+        if not rows:
+            rows = [{}]
+        out: dict[str, Point] = {}
+        for r in rows:
+            params = {**self.fixed, **r}
+            pid = point_id(params)
+            out.setdefault(pid, Point(pid, params))
+        return list(out.values())
+
+
+def load_study(path: str | Path) -> Study:
+    """Read a study TOML (see the module docstring); relative paths are taken from its folder."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise ConfigError(f"study file {path} does not exist") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"study file {path} is not valid TOML: {exc}") from None
+    unknown = set(data) - _TOP_KEYS
+    if unknown:
+        raise ConfigError(
+            f"study file {path}: unknown table(s) {sorted(unknown)}; expected {sorted(_TOP_KEYS)}"
+        )
+    st = data.get("study", {})
+    unknown = set(st) - _STUDY_KEYS
+    if unknown:
+        raise ConfigError(
+            f"study file {path}: unknown [study] key(s) {sorted(unknown)}; "
+            f"expected {sorted(_STUDY_KEYS)}"
+        )
+    if "function" not in st:
+        raise ConfigError(f"study file {path}: [study] needs function = 'module:function'")
+    base = path.resolve().parent
+    out = st.get("out")
+    return Study(
+        function=st["function"],
+        grid=dict(data.get("grid", {})),
+        fixed=dict(data.get("fixed", {})),
+        points=tuple(data.get("points", [])),
+        name=str(st.get("name", path.stem)),
+        out=(base / out) if out else base / f"{path.stem}-results",
+        batch_size=st.get("batch_size", 1),
+        paths=tuple(str(base / p) for p in st.get("paths", [])),
+    )
+
+
+# ------------------------------------------------------------------------------ worker side
+def _resolve(function: str, paths: Sequence[str]) -> Callable[..., Any]:
+    for p in paths:
+        if p not in sys.path:
+            sys.path.insert(0, p)
+    mod_name, fn_name = function.split(":")
+    try:
+        fn = getattr(importlib.import_module(mod_name), fn_name)
+    except (ImportError, AttributeError) as exc:
+        raise ConfigError(f"cannot import study function {function!r}: {exc}") from None
+    return fn
+
+
+def _one_line(exc: BaseException) -> str:
+    lines = str(exc).strip().splitlines()
+    return lines[0] if lines else ""
+
+
+def _run_point(fn: Callable[..., Any], pid: str, params: dict[str, Any]) -> Record:
+    t0 = time.perf_counter()
+    rec: Record = {"id": pid, "params": params, "status": "ok", "result": None, "error": None}
+    try:
+        res = fn(**params)
+        if not isinstance(res, dict):
+            res = {"value": res}
+        rec["result"] = json.loads(json.dumps(res, default=_json_default))
+    except Exception as exc:  # a failing point is recorded, the sweep goes on
+        rec["status"] = "failed"
+        rec["error"] = {"type": type(exc).__name__, "message": _one_line(exc)}
+    rec["elapsed_s"] = time.perf_counter() - t0
+    rec["worker"] = f"{socket.gethostname()}:{os.getpid()}"
+    rec["finished_at"] = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
+    return rec
+
+
+def run_batch(
+    function: str, paths: Sequence[str], batch: Sequence[tuple[str, dict[str, Any]]]
+) -> list[Record]:
+    """Run a batch of points ``[(id, params), ...]``; the task sent to workers.
+
+    Returns one record per point (``status`` "ok" with ``result``, or "failed" with
+    ``error = {"type", "message"}``).
+    """
+    try:
+        fn = _resolve(function, paths)
+    except ConfigError as exc:
+        return [_failed(pid, params, exc) for pid, params in batch]
+    return [_run_point(fn, pid, params) for pid, params in batch]
+
+
+def _failed(pid: str, params: dict[str, Any], exc: BaseException) -> Record:
+    return {
+        "id": pid,
+        "params": params,
+        "status": "failed",
+        "result": None,
+        "error": {"type": type(exc).__name__, "message": _one_line(exc)},
+        "elapsed_s": None,
+        "worker": None,
+        "finished_at": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
+    }
+
+
+# ------------------------------------------------------------------------------ records
+def _points_dir(out: Path) -> Path:
+    return out / "points"
+
+
+def _atomic_write(path: Path, text: str) -> None:
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def write_record(out: Path, rec: Record) -> Path:
+    """Write ``points/<id>.json`` atomically (temporary file + rename)."""
+    path = _points_dir(out) / f"{rec['id']}.json"
+    _atomic_write(path, json.dumps(rec, indent=1, default=_json_default))
+    return path
+
+
+def read_records(out: str | Path) -> dict[str, Record]:
+    """All point records in an output folder, keyed by point id (unreadable files skipped)."""
+    pdir = _points_dir(Path(out))
+    recs: dict[str, Record] = {}
+    if not pdir.is_dir():
+        return recs
+    for f in sorted(pdir.glob("*.json")):
+        if f.name.startswith("."):
+            continue
+        try:
+            rec = json.loads(f.read_text())
+        except (OSError, json.JSONDecodeError) as exc:
+            log.warning("ignoring unreadable record %s (%s); the point will be rerun", f, exc)
+            continue
+        if rec.get("id") == f.stem:
+            recs[f.stem] = rec
+    return recs
+
+
+def _cell(v: Any) -> Any:
+    if v is None or isinstance(v, str | int | float | bool):
+        return v
+    return json.dumps(v, default=_json_default)
+
+
+def write_summary(out: str | Path, points: Sequence[Point], records: dict[str, Record]) -> Path:
+    """Write ``summary.csv`` (and ``summary.parquet`` if pyarrow exists): one row per point.
+
+    Columns: id, status, the parameters, the result's keys (non-scalar values as JSON; a key
+    that clashes with a parameter or a fixed column becomes ``result.<key>``), error_type,
+    error_message, elapsed_s, worker. Points without a record have status "pending".
+    """
+    out = Path(out)
+    rows: list[dict[str, Any]] = []
+    pcols: dict[str, None] = {}
+    rcols: dict[str, None] = {}
+    for p in points:
+        pcols.update(dict.fromkeys(p.params))
+    for p in points:
+        rec = records.get(p.id)
+        row: dict[str, Any] = {"id": p.id, "status": rec["status"] if rec else "pending"}
+        row.update({k: _cell(v) for k, v in p.params.items()})
+        if rec:
+            for k, v in (rec.get("result") or {}).items():
+                col = f"result.{k}" if (k in pcols or k in _RESERVED) else k
+                rcols[col] = None
+                row[col] = _cell(v)
+            err = rec.get("error") or {}
+            row.update(
+                error_type=err.get("type"),
+                error_message=err.get("message"),
+                elapsed_s=rec.get("elapsed_s"),
+                worker=rec.get("worker"),
+            )
+        rows.append(row)
+    cols = ["id", "status", *pcols, *rcols, "error_type", "error_message", "elapsed_s", "worker"]
+    path = out / "summary.csv"
+    tmp = path.with_name(f".summary.{os.getpid()}.tmp")
+    with tmp.open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=cols, restval="")
+        w.writeheader()
+        w.writerows(rows)
+    os.replace(tmp, path)
+    with contextlib.suppress(ImportError):
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        tmpq = path.with_name(f".summary.{os.getpid()}.parquet.tmp")
+        pq.write_table(pa.Table.from_pylist([{c: r.get(c) for c in cols} for r in rows]), tmpq)
+        os.replace(tmpq, out / "summary.parquet")
+    return path
+
+
+# ------------------------------------------------------------------------------ driver
+@dataclasses.dataclass
+class SweepReport:
+    """Live counts of a sweep (updated as records arrive) and its records."""
+
+    out: Path
+    total: int
+    skipped: int = 0
+    pending: int = 0
+    done: int = 0
+    failed: int = 0
+    elapsed_s: float = 0.0
+    records: dict[str, Record] = dataclasses.field(default_factory=dict)
+
+    @property
+    def finished(self) -> int:
+        """Points finished in this run (ok or failed)."""
+        return self.done + self.failed
+
+
+def _batches(todo: list[Point], size: int) -> Iterator[list[tuple[str, dict[str, Any]]]]:
+    for i in range(0, len(todo), size):
+        yield [(p.id, p.params) for p in todo[i : i + size]]
+
+
+def _serial(study: Study, todo: list[Point]) -> Iterator[list[Record]]:
+    fn = _resolve(study.function, study.paths)
+    for p in todo:
+        yield [_run_point(fn, p.id, p.params)]
+
+
+@contextlib.contextmanager
+def _dask_client(scheduler: str | None, workers: int | None, timeout_s: float) -> Iterator[Any]:
+    from distributed import Client, LocalCluster
+
+    cluster = None
+    try:
+        if scheduler:
+            try:
+                client = Client(scheduler, timeout=f"{timeout_s}s")
+            except OSError as exc:
+                raise ConfigError(
+                    f"cannot connect to the Dask scheduler {scheduler}: {exc}"
+                ) from None
+        else:
+            n = workers or max(1, min(2, os.cpu_count() or 1))
+            cluster = LocalCluster(
+                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
+            )
+            client = Client(cluster)
+        try:
+            yield client
+        finally:
+            client.close()
+    finally:
+        if cluster is not None:
+            cluster.close()
+
+
+def _dask(
+    study: Study,
+    todo: list[Point],
+    batch_size: int,
+    scheduler: str | None,
+    workers: int | None,
+    timeout_s: float,
+) -> Iterator[list[Record]]:
+    from distributed import as_completed
+
+    with _dask_client(scheduler, workers, timeout_s=timeout_s) as client:
+        futures = {}
+        tag = uuid.uuid4().hex[:8]
+        for batch in _batches(todo, batch_size):
+            key = f"barhinge-point-{batch[0][0]}-{tag}"
+            fut = client.submit(
+                run_batch, study.function, list(study.paths), batch, key=key, pure=False
+            )
+            futures[fut] = batch
+        for fut in as_completed(futures):
+            batch = futures[fut]
+            try:
+                recs = fut.result()
+            except Exception as exc:  # e.g. KilledWorker after repeated worker deaths
+                recs = [_failed(pid, params, exc) for pid, params in batch]
+            yield recs
+
+
+def run_study(
+    study: Study,
+    *,
+    out: str | Path | None = None,
+    mode: Mode = "local",
+    scheduler: str | None = None,
+    workers: int | None = None,
+    batch_size: int | None = None,
+    retry_failed: bool = False,
+    on_start: Callable[[SweepReport], None] | None = None,
+    on_record: Callable[[Record, SweepReport], None] | None = None,
+    summary_every_s: float = 2.0,
+    connect_timeout_s: float = 30.0,
+) -> SweepReport:
+    """Run (or resume) a study; each point's record is written as soon as it finishes.
+
+    Parameters
+    ----------
+    study : Study
+    out : path, optional
+        Output folder (default ``study.out``).
+    mode : "serial", "local" or "dask"
+        In this process; on a Dask ``LocalCluster`` of ``workers`` processes (default 2); on
+        the existing cluster at ``scheduler`` (``"tcp://host:port"``, implies "dask").
+    batch_size : int, optional
+        Points per Dask task (default ``study.batch_size``).
+    retry_failed : bool
+        Rerun points whose record says "failed" (default: keep them).
+    on_start, on_record : callables, optional
+        Progress hooks: ``on_start(report)`` once the pending points are known,
+        ``on_record(record, report)`` after each record is written.
+    summary_every_s : float
+        Rewrite ``summary.csv`` at most this often during the sweep (and always at the end).
+    connect_timeout_s : float
+        Timeout for connecting to ``scheduler`` (ConfigError when it passes).
+
+    Returns
+    -------
+    SweepReport
+        Counts of this run and the records of all the study's points.
+
+    Raises
+    ------
+    KeyboardInterrupt
+        Passed on after the summary of what finished is written; a rerun resumes.
+    """
+    if scheduler:
+        mode = "dask"
+    if mode not in ("serial", "local", "dask"):
+        raise ConfigError(f"mode must be 'serial', 'local' or 'dask', got {mode!r}")
+    if mode == "dask" and not scheduler:
+        raise ConfigError("mode 'dask' needs a scheduler address such as tcp://127.0.0.1:8786")
+    out = Path(out) if out is not None else study.out
+    if out is None:
+        raise ConfigError("no output folder: give out= or set [study] out")
+    t0 = time.perf_counter()
+    pdir = _points_dir(out)
+    pdir.mkdir(parents=True, exist_ok=True)
+    for stale in pdir.glob(".*.tmp"):
+        stale.unlink(missing_ok=True)
+    spec = dataclasses.asdict(study) | {"out": str(out)}
+    _atomic_write(out / "study.json", json.dumps(spec, indent=1, default=_json_default))
+
+    points = study.expand()
+    known = read_records(out)
+    mine = {p.id for p in points}
+    stray = len(set(known) - mine)
+    if stray:
+        log.info("%d records in %s belong to points outside this study; left alone", stray, out)
+    records = {k: v for k, v in known.items() if k in mine}
+    todo = [
+        p
+        for p in points
+        if p.id not in records or (retry_failed and records[p.id].get("status") != "ok")
+    ]
+    rep = SweepReport(
+        out=out, total=len(points), skipped=len(points) - len(todo), pending=len(todo)
+    )
+    rep.records = records
+    if on_start:
+        on_start(rep)
+    log.info("study %s: %d points, %d to run (%s)", study.name, len(points), len(todo), mode)
+
+    bs = study.batch_size if batch_size is None else int(batch_size)
+    if bs < 1:
+        raise ConfigError(f"batch_size must be >= 1, got {bs}")
+    if not todo:
+        stream: Iterator[list[Record]] = iter(())
+    elif mode == "serial":
+        stream = _serial(study, todo)
+    else:
+        stream = _dask(study, todo, bs, scheduler, workers, connect_timeout_s)
+    seen: set[str] = set()
+    last = time.perf_counter()
+    try:
+        for recs in stream:
+            for rec in recs:
+                if rec["id"] in seen:  # cannot happen with one task per point; belt and braces
+                    log.warning("point %s finished twice; keeping the first record", rec["id"])
+                    continue
+                seen.add(rec["id"])
+                write_record(out, rec)
+                records[rec["id"]] = rec
+                rep.pending -= 1
+                if rec["status"] == "ok":
+                    rep.done += 1
+                else:
+                    rep.failed += 1
+                    log.info("point %s failed: %s", rec["id"], rec["error"])
+                rep.elapsed_s = time.perf_counter() - t0
+                if on_record:
+                    on_record(rec, rep)
+                if time.perf_counter() - last > summary_every_s:
+                    write_summary(out, points, records)
+                    last = time.perf_counter()
+    finally:
+        close = getattr(stream, "close", None)
+        if close is not None:  # shut a cluster down now, not when the generator is collected
+            close()
+        write_summary(out, points, records)
+        rep.elapsed_s = time.perf_counter() - t0
+    return rep

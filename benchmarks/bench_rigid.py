@@ -1,0 +1,76 @@
+"""Time per step of the rigid folding path (bh.rigid_fold) for Miura-ori sheets.
+
+Usage: python benchmarks/bench_rigid.py [--sizes 5 10 20 35 50 70] [--steps 30] [--repeat 1]
+
+Each sheet (n x n unit cells of bh.patterns.miura, i.e. 2n x 2n quad panels) is folded from
+flat to a 120 deg zig-zag fold by one actuator crease in the middle. Printed per size: number
+of crease variables and interior vertices, set-up time (constraints + face tree), median and
+90th percentile wall time per step (steps 2..N; step 1 leaves the flat state and also checks
+the actuators), median corrector iterations, worst closure residual; and the slope of
+log(time per step) against log(number of creases).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+import barhinge as bh
+from barhinge.kinematics.constraints import RigidConstraints
+
+
+def run(n: int, steps: int) -> dict:
+    cp = bh.patterns.miura(n, n)
+    lay = bh.patterns.miura_layout(n, n)
+    zz = lay.interior_zigzag_edges
+    e = int(zz[len(zz) // 2])
+    sign = 1.0 if cp.assignment[e] == "V" else -1.0
+    t0 = time.perf_counter()
+    rc = RigidConstraints.from_pattern(cp)
+    _ = rc.face_tree
+    setup = time.perf_counter() - t0
+    opt = bh.kinematics.RigidOptions(check_rank=False)
+    path = bh.rigid_fold(cp, [e], [sign * 120.0], steps=steps, options=opt)
+    dt = np.diff(path.wall_time)
+    return {
+        "cells": f"{n}x{n}",
+        "creases": rc.n_var,
+        "vertices": len(rc.vertices),
+        "setup_s": setup,
+        "first_s": dt[0],
+        "median_ms": 1e3 * float(np.median(dt[1:])),
+        "p90_ms": 1e3 * float(np.percentile(dt[1:], 90)),
+        "iters": float(np.median(path.iterations[2:])),
+        "closure": path.meta["max_closure"],
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[5, 10, 20, 35, 50, 70])
+    ap.add_argument("--steps", type=int, default=30)
+    ap.add_argument("--repeat", type=int, default=1, help="runs per size (median is kept)")
+    args = ap.parse_args()
+    rows = []
+    hdr = (f"{'cells':>7} {'creases':>8} {'int.vert':>8} {'setup s':>8} {'step1 s':>8} "
+           f"{'median ms/step':>15} {'p90 ms':>8} {'iters':>6} {'max closure':>12}")  # fmt: skip
+    print(hdr)
+    print("-" * len(hdr))
+    for n in args.sizes:
+        runs = [run(n, args.steps) for _ in range(args.repeat)]
+        r = sorted(runs, key=lambda d: d["median_ms"])[len(runs) // 2]
+        rows.append(r)
+        print(f"{r['cells']:>7} {r['creases']:>8d} {r['vertices']:>8d} {r['setup_s']:>8.2f} "
+              f"{r['first_s']:>8.2f} {r['median_ms']:>15.1f} {r['p90_ms']:>8.1f} "
+              f"{r['iters']:>6.1f} {r['closure']:>12.1e}", flush=True)  # fmt: skip
+    if len(rows) >= 2:
+        x = np.log([r["creases"] for r in rows])
+        y = np.log([r["median_ms"] for r in rows])
+        print(f"\nscaling: time per step ~ creases^{np.polyfit(x, y, 1)[0]:.2f} "
+              f"(fit over {len(rows)} sizes)")  # fmt: skip
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,144 @@
+"""Rigid folding paths: Miura-ori against Schenk & Guest (2013), constraint residuals and
+panel edge lengths along a large path, schedules, and the one-line diagnostics."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import barhinge as bh
+from barhinge.errors import ConfigError
+from barhinge.kinematics.constraints import RigidConstraints
+
+
+@pytest.fixture(scope="module")
+def miura30_path():
+    """30 x 30 cells (61 x 61 vertices, 7080 creases), driven by one zig-zag crease in the
+    middle from flat to -150 deg (its mountain side) in 10 steps."""
+    nx = ny = 30
+    cp = bh.patterns.miura(nx, ny, a=1.0, b=1.3, alpha=55.0)
+    lay = bh.patterns.miura_layout(nx, ny)
+    zz = lay.interior_zigzag_edges
+    e = int(zz[len(zz) // 2])
+    sign = 1.0 if cp.assignment[e] == "V" else -1.0
+    path = bh.rigid_fold(cp, [e], [sign * 150.0], steps=10)
+    return cp, lay, e, sign, path
+
+
+def test_miura_path_keeps_constraints_and_lengths(miura30_path):
+    cp, _, _, _, path = miura30_path
+    assert path.kind == "rigid" and path.converged
+    assert path.X.shape == (11, cp.n_vertices, 3)
+    assert path.fold_angles_deg.shape == (11, cp.n_edges)
+    rc = RigidConstraints.from_pattern(cp)
+    X0 = cp.vertices3d
+    L0 = np.linalg.norm(X0[cp.edges[:, 1]] - X0[cp.edges[:, 0]], axis=1)
+    for s in range(path.n_states):
+        rho = np.radians(path.fold_angles_deg[s, rc.crease_edge])
+        # residual recomputed from the stored angles (independent of the solver's record)
+        assert np.abs(rc.residual(rho)).max() < 1e-10
+        X = path.X[s]
+        L = np.linalg.norm(X[cp.edges[:, 1]] - X[cp.edges[:, 0]], axis=1)
+        assert np.abs(L - L0).max() < 1e-10
+        # panel diagonals too (rigid, planar panels)
+        for f in cp.faces[:: max(1, cp.n_faces // 200)]:
+            d0 = np.linalg.norm(X0[f[2]] - X0[f[0]])
+            assert abs(np.linalg.norm(X[f[2]] - X[f[0]]) - d0) < 1e-10
+
+
+def test_miura_path_follows_schenk_guest(miura30_path):
+    """Schenk & Guest (2013, PNAS 110(9):3276, Eq. 1) with facet angle theta = rho_z / 2:
+    straight creases |rho_s| = 2 arctan(cos(gamma) tan(theta)); cell dimensions
+    H = a sin(theta) sin(gamma), S = b cos(theta) tan(gamma) / sqrt(1 + cos^2 theta tan^2
+    gamma), L = a sqrt(1 - sin^2 theta sin^2 gamma), V = b / sqrt(1 + cos^2 theta tan^2 gamma),
+    measured on the rebuilt coordinates at every step."""
+    cp, lay, e, sign, path = miura30_path
+    a, b, g = 1.0, 1.3, np.radians(55.0)
+    ni = lay.ni
+    vid = lambda i, j: j * ni + i  # noqa: E731  (vertex id of grid point (i, j))
+    for s in range(1, path.n_states):
+        rho = path.fold_angles_deg[s]
+        th = np.radians(sign * rho[e]) / 2
+        ref = bh.patterns.miura_fold_angles(lay, 55.0, np.degrees(th))
+        np.testing.assert_allclose(rho, ref, rtol=0, atol=1e-9)
+        rs = np.radians(np.abs(rho[lay.interior_straight_edges]))
+        np.testing.assert_allclose(rs, 2 * np.arctan(np.cos(g) * np.tan(th)), rtol=0, atol=1e-9)
+        D = np.sqrt(1 + np.cos(th) ** 2 * np.tan(g) ** 2)
+        H, S = a * np.sin(th) * np.sin(g), b * np.cos(th) * np.tan(g) / D
+        L, V = a * np.sqrt(1 - np.sin(th) ** 2 * np.sin(g) ** 2), b / D
+        X = path.X[s]
+        for i, j in [(0, 0), (10, 20), (40, 50), (56, 2)]:
+            p0, p2 = X[vid(i, j)], X[vid(i + 2, j)]
+            assert abs(np.linalg.norm(p2 - p0) - 2 * L) < 1e-9
+            assert abs(np.linalg.norm(X[vid(i, j + 2)] - p0) - 2 * S) < 1e-9
+            # even-i vertices lie in one plane, odd-i ones at height H above it
+            q = X[vid(i, j + 1)]
+            n = np.cross(p2 - p0, q - p0)
+            n /= np.linalg.norm(n)
+            assert abs(abs(n @ (X[vid(i + 1, j)] - p0)) - H) < 1e-9
+            # zig-zag offset V: component of (i, j)->(i, j+1) along the straight direction
+            assert abs(abs((q - p0) @ (p2 - p0)) / (2 * L) - V) < 1e-9
+
+
+def test_path_with_actuators_schedule_and_folded_start():
+    """A table schedule from a folded start state; starts from the pattern's own geometry and
+    returns the schedule's angles exactly."""
+    cp = bh.patterns.miura(3, 2, fold=20.0)
+    lay = bh.patterns.miura_layout(3, 2)
+    e = int(lay.interior_straight_edges[3])
+    start = cp.fold_angles[e]
+    table = np.array([[start * 1.5], [start * 2.0], [start * 1.2]])
+    act = bh.Actuators(edges=[e], table_deg=table)
+    path = bh.rigid_fold(cp, act)
+    assert path.n_states == 4
+    np.testing.assert_allclose(path.fold_angles_deg[0], cp.fold_angles, atol=1e-9)
+    np.testing.assert_allclose(path.fold_angles_deg[1:, e], table[:, 0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(path.actuator_targets_deg[1:, 0], table[:, 0])
+    assert path.meta["dof"] == [1, 1, 1, 1]
+    # the state at step 0 is the input geometry
+    np.testing.assert_allclose(path.X[0], cp.vertices3d, atol=1e-12)
+
+
+def test_actuator_that_is_not_a_crease_is_rejected():
+    cp = bh.patterns.miura(2, 2)
+    b = int(cp.boundary_edges[0])
+    with pytest.raises(ConfigError, match=f"actuator edge {b} .* not a foldable"):
+        bh.rigid_fold(cp, [b], [30.0], steps=2)
+
+
+def test_under_determined_actuators_are_reported():
+    """Triangulated Miura: DOF = boundary edges - 3 (Tachi 2010) >> 1 actuator."""
+    cp = bh.patterns.miura(2, 2)
+    zz = bh.patterns.miura_layout(2, 2).interior_zigzag_edges
+    with pytest.raises(ConfigError, match="free motion"):
+        bh.rigid_fold(cp, [int(zz[0])], [-40.0], steps=4, triangulated=True)
+
+
+def test_incompatible_over_determined_actuators_are_reported():
+    """Miura (1 DOF) driven at two creases with targets that contradict S&G's relation."""
+    cp = bh.patterns.miura(2, 2, fold=30.0)
+    lay = bh.patterns.miura_layout(2, 2)
+    z, s = int(lay.interior_zigzag_edges[0]), int(lay.interior_straight_edges[0])
+    tz, ts = cp.fold_angles[z] * 1.5, cp.fold_angles[s] * 0.5
+    with pytest.raises(ConfigError, match="over-determine"):
+        bh.rigid_fold(cp, [z, s], [tz, ts], steps=4)
+
+
+def test_compatible_over_determined_actuators_are_accepted():
+    """Two creases of the same family driven alike stay compatible."""
+    cp = bh.patterns.miura(2, 2, fold=30.0)
+    zz = bh.patterns.miura_layout(2, 2).interior_zigzag_edges
+    z = [int(k) for k in zz if cp.fold_angles[k] > 0][:2]
+    path = bh.rigid_fold(cp, z, [100.0, 100.0], steps=4)
+    assert path.converged
+    np.testing.assert_allclose(path.fold_angles_deg[-1, z], [100.0, 100.0], atol=1e-9)
+
+
+def test_locking_threshold_stops_the_path():
+    cp = bh.patterns.miura(2, 2)
+    e = int(bh.patterns.miura_layout(2, 2).interior_zigzag_edges[0])
+    sign = 1.0 if cp.assignment[e] == "V" else -1.0
+    opt = bh.kinematics.RigidOptions(lock_deg=120.0)
+    with pytest.raises(bh.ConvergenceError, match="locked") as info:
+        bh.rigid_fold(cp, [e], [sign * 150.0], steps=5, options=opt)
+    assert info.value.last_state.kind == "rigid"

@@ -1,0 +1,171 @@
+"""Assembled energy, internal force and tangent of BarHingeModel: element-by-element oracle,
+finite differences of the assembled energy, rigid-body invariance, zero-eigenvalue counts."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
+
+import barhinge as bh
+from barhinge.kernels.reference import assemble_reference
+from barhinge.model.calibrate import Material
+from barhinge.model.model import BarHingeModel
+from barhinge.pattern.crease import CreasePattern
+
+MAT = Material(E=1.0, nu=0.3, t=0.05)
+
+
+def single_fold(fold_deg: float = 0.0) -> CreasePattern:
+    """Two triangles sharing the valley crease 0 -> 1 (the y axis); the right wing (vertex 2)
+    folded up by ``fold_deg`` (valley > 0)."""
+    V = np.array([[0, 0, 0], [0, 1, 0], [1, 0.5, 0], [-1, 0.5, 0]], float)
+    R = Rotation.from_rotvec([0.0, -np.radians(fold_deg), 0.0])
+    V[2] = R.apply(V[2])
+    return CreasePattern(
+        V, [[0, 1], [0, 2], [2, 1], [1, 3], [3, 0]], ["V", "B", "B", "B", "B"],
+        faces=[[0, 2, 1], [0, 1, 3]],
+    )  # fmt: skip
+
+
+def models():
+    out = [BarHingeModel.from_pattern(single_fold(40.0), "N4B5", MAT)]
+    cp = bh.patterns.miura(2, 1, fold=35.0)
+    for s in ("N4B5", "N5B8"):
+        out.append(BarHingeModel.from_pattern(cp, s, MAT))
+    out.append(
+        BarHingeModel.from_pattern(
+            cp, "N5B8", MAT, fold_law="penetration", fold_limits_deg=(-60, 60), strain="engineering"
+        )
+    )
+    return out
+
+
+MODELS = models()
+
+
+def perturbed(m: BarHingeModel, seed: int, amp: float = 0.05) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    return m.X0 + amp * rng.normal(size=m.X0.shape)
+
+
+@pytest.mark.parametrize("mi", range(len(MODELS)))
+def test_assembly_equals_element_by_element_oracle(mi: int) -> None:
+    m = MODELS[mi]
+    X = perturbed(m, mi)
+    ev = m.evaluate(X)
+    E, f, K = assemble_reference(m, X)
+    assert ev.energy == pytest.approx(E, rel=1e-12)
+    assert np.abs(ev.force - f).max() <= 1e-12 * np.abs(f).max()
+    Kd = ev.K.toarray()
+    assert np.abs(Kd - K).max() <= 1e-12 * np.abs(K).max()
+    assert np.array_equal(Kd, Kd.T)
+    assert m.energy(X) == pytest.approx(ev.energy, rel=1e-13)
+    # the force-only path uses the element-major gradient kernel: same to rounding
+    assert np.abs(m.internal_force(X) - ev.force).max() <= 1e-13 * np.abs(ev.force).max()
+
+
+@pytest.mark.parametrize("mi", range(len(MODELS)))
+def test_assembled_force_and_tangent_match_fd_of_energy(mi: int) -> None:
+    """Central differences of the assembled energy / force along random directions; relative
+    error <= 1e-6 (step 1e-6 gives truncation ~1e-12 and round-off ~1e-10)."""
+    m = MODELS[mi]
+    X = perturbed(m, 10 + mi)
+    ev = m.evaluate(X)
+    rng = np.random.default_rng(mi)
+    h = 1e-6
+    for _ in range(3):
+        v = rng.normal(size=m.n_dof)
+        v /= np.linalg.norm(v)
+        dE = (m.energy(X.ravel() + h * v) - m.energy(X.ravel() - h * v)) / (2 * h)
+        assert dE == pytest.approx(ev.force @ v, rel=1e-6, abs=1e-9 * np.abs(ev.force).max())
+        df = (m.internal_force(X.ravel() + h * v) - m.internal_force(X.ravel() - h * v)) / (2 * h)
+        Kv = ev.K @ v
+        assert np.abs(df - Kv).max() <= 1e-6 * np.abs(Kv).max()
+
+
+@settings(max_examples=15, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), mi=st.integers(0, len(MODELS) - 1))
+def test_rigid_body_motion_leaves_energy_and_rotates_force(seed: int, mi: int) -> None:
+    m = MODELS[mi]
+    rng = np.random.default_rng(seed)
+    R = Rotation.random(random_state=seed % 2**31)
+    c = rng.normal(size=3) * 3
+    # unstressed: the reference state moved rigidly has zero energy and zero force
+    ev0 = m.evaluate(R.apply(np.array(m.X0)) + c, tangent=False)
+    assert abs(ev0.energy) <= 1e-20
+    assert np.abs(ev0.force).max() <= 1e-11 * max(m.bar_EA.max(), m.hinge_k.max())
+    # stressed: energy invariant, force rotates with the body
+    X = perturbed(m, seed % 1000)
+    ev = m.evaluate(X, tangent=False)
+    evr = m.evaluate(R.apply(X) + c, tangent=False)
+    assert evr.energy == pytest.approx(ev.energy, rel=1e-10)
+    fr = R.apply(ev.force.reshape(-1, 3)).ravel()
+    assert np.abs(evr.force - fr).max() <= 1e-9 * np.abs(fr).max()
+
+
+def n_zero_eigenvalues(m: BarHingeModel, X: np.ndarray | None = None) -> tuple[int, float]:
+    """Number of eigenvalues below 1e-10 * the largest, and the gap ratio to the next one."""
+    w = np.linalg.eigvalsh(m.tangent(m.X0 if X is None else X).toarray())
+    tol = 1e-10 * w.max()
+    nz = int((np.abs(w) < tol).sum())
+    return nz, w[nz] / w.max()
+
+
+def test_zero_eigenvalues_single_fold() -> None:
+    """Two triangles and one crease: 12 dof, 5 bars. With fold stiffness 0 the free tangent
+    has 6 rigid-body modes + 1 folding mechanism = 7 zero eigenvalues; with fold stiffness > 0
+    exactly 6. Checked flat and folded."""
+    for fold in (0.0, 50.0):
+        m0 = BarHingeModel.from_pattern(single_fold(fold), "N4B5", MAT, fold_stiffness=0.0)
+        nz, gap = n_zero_eigenvalues(m0)
+        assert nz == 7 and gap > 1e-7
+        m1 = BarHingeModel.from_pattern(single_fold(fold), "N4B5", MAT)
+        nz, gap = n_zero_eigenvalues(m1)
+        assert nz == 6 and gap > 1e-7
+
+
+@pytest.mark.parametrize("scheme", ["N4B5", "N5B8"])
+def test_zero_eigenvalues_degree4_vertex(scheme: str) -> None:
+    """Degree-4 vertex with four parallelogram panels (a 1x1-cell Miura), panels triangulated
+    with stiff bending hinges.
+
+    * folded (theta = 30 deg), fold stiffness 0: a degree-n vertex has n - 3 = 1 rigid-folding
+      DOF, so 6 + 1 = 7 zero eigenvalues;
+    * flat, fold stiffness 0: 8 -- at the flat state the linearised loop-closure constraints
+      lose rank and the vertex has two first-order flexes (the tangents of its two folding
+      branches, Tachi 2009 / Demaine & O'Rourke), so 6 + 2;
+    * any state with fold stiffness > 0: exactly the 6 rigid-body modes.
+    """
+    for fold, expect in ((30.0, 7), (None, 8)):
+        cp = bh.patterns.miura(1, 1, fold=fold)
+        nz, gap = n_zero_eigenvalues(BarHingeModel.from_pattern(cp, scheme, MAT, fold_stiffness=0.0))
+        assert nz == expect and gap > 1e-7
+        nz, gap = n_zero_eigenvalues(BarHingeModel.from_pattern(cp, scheme, MAT))
+        assert nz == 6 and gap > 1e-7
+
+
+def test_evaluate_split_and_moments() -> None:
+    m = MODELS[2]
+    X = perturbed(m, 7)
+    ev = m.evaluate(X)
+    fold = m.hinge_kind == "fold"
+    d = ev.hinge_angle - m.rest_angle
+    assert ev.energy_fold == pytest.approx(0.5 * np.sum(m.hinge_k[fold] * d[fold] ** 2))
+    assert ev.energy_bend == pytest.approx(0.5 * np.sum(m.hinge_k[~fold] * d[~fold] ** 2))
+    eps = ev.bar_strain
+    assert ev.energy_bars == pytest.approx(0.5 * np.sum(m.bar_EA * m.bar_L0 * eps**2))
+    assert np.allclose(ev.hinge_moment, m.hinge_k * d)
+    assert np.allclose(m.hinge_angles(X), ev.hinge_angle)
+    # flattened coordinates are accepted
+    assert m.energy(X.ravel()) == pytest.approx(ev.energy)
+
+
+def test_assembly_scatter_pattern_is_reused() -> None:
+    m = MODELS[1]
+    K1 = m.tangent(perturbed(m, 1))
+    K2 = m.tangent(perturbed(m, 2))
+    assert np.shares_memory(K1.indices, K2.indices) and np.shares_memory(K1.indptr, K2.indptr)
+    assert K1.data is not K2.data
