@@ -351,8 +351,7 @@ def dof(
     if rep.folded is not None:
         t.add_column("folded state nearby")
     t.add_row("flat", *[str(r.flat) for r in reps])
-    t.add_row("variables / equations",
-              *[f"{r.n_variables} / {r.n_equations}" for r in reps])  # fmt: skip
+    t.add_row("variables / equations", *[f"{r.n_variables} / {r.n_equations}" for r in reps])
     t.add_row("counted DOF (Tachi 2010)", *[str(r.counted_dof) for r in reps])
     t.add_row("DOF from rank", *[f"{r.global_dof} (rank {r.rank}, {r.method})" for r in reps])
     t.add_row("redundant constraints", *[str(r.redundant) for r in reps])
@@ -366,13 +365,72 @@ def dof(
 
     t.add_row("local DOF (value: vertices)", *[hist(r.local) for r in reps])
     t.add_row("region DOF (value: vertices)", *[hist(r.region) for r in reps])
-    t.add_row("suggested actuators (edges)",
-              *[" ".join(map(str, r.actuators.tolist())) or "-" for r in reps])  # fmt: skip
+    acts = [" ".join(map(str, r.actuators.tolist())) or "-" for r in reps]
+    t.add_row("suggested actuators (edges)", *acts)
     console.print(t)
     if rep.note:
         console.print(f"note: {rep.note}", highlight=False)
     if png is not None:
         console.print(f"wrote {png}")
+
+
+# --- fold --form-only: model no more than a scene needs (studies) ---
+
+
+def form_only_model(scene) -> tuple[str, str]:
+    """("rigid" | "bar-hinge", reason): the model a scene needs when only its folded form is
+    wanted. Rigid kinematics is exact and fastest for a form driven by actuators alone
+    (docs/speed-accuracy.md); loads or prescribed displacements need the compliant model."""
+    import numpy as np
+
+    if scene.actuators is None or not scene.actuators.n:
+        return "bar-hinge", "no actuators"
+    if np.any(scene.loads) or np.isfinite(scene.prescribed).any():
+        return "bar-hinge", "the scene has loads or prescribed displacements"
+    return "rigid", "actuators only"
+
+
+def _fold_form_rigid(scene, out: Path) -> tuple[object, dict] | None:
+    """Fold ``scene`` by rigid kinematics and write fold_path.npz, fold_path.fold and
+    summary.json into ``out``; None (with the reason on stderr) when rigid kinematics cannot
+    follow the actuators, so the caller falls back to the bar-and-hinge solver."""
+    import time
+
+    import numpy as np
+
+    from barhinge.kinematics.path import RigidOptions, rigid_fold
+    from barhinge.pattern.fold import write_fold_path
+
+    cp = scene.model.pattern  # its state is the model's reference state X0
+    t0 = time.perf_counter()
+    try:
+        # no DOF recount per state (a diagnostic that costs a dense SVD per state)
+        opts = RigidOptions(max_cutbacks=3, check_rank=False)
+        path = rigid_fold(cp, scene.actuators, steps=scene.steps, options=opts)
+    except BarhingeError as exc:
+        err_console.print(f"rigid kinematics cannot fold it ({exc}); using the bar-and-hinge model",
+                          highlight=False, soft_wrap=True)  # fmt: skip
+        return None
+    out.mkdir(parents=True, exist_ok=True)
+    files = [path.save(out / "fold_path.npz"), write_fold_path(cp, path, out / "fold_path.fold")]
+    rho = path.fold_angles_deg[-1]
+    info = {
+        "scene": scene.name,
+        "model": "rigid",
+        "n_states": int(path.n_states),
+        "wall_time_s": time.perf_counter() - t0,
+        "max_abs_fold_deg": float(np.max(np.abs(rho))) if len(rho) else 0.0,
+        "actuators": {
+            "edges": scene.actuators.edges.tolist(),
+            "angle_deg": rho[scene.actuators.edges].tolist(),
+        },
+        "closure_residual": path.meta.get("max_residual"),
+    }
+    js = out / "summary.json"
+    js.write_text(json.dumps(info, indent=2, default=_json_default) + "\n")
+    files.append(js)
+    return path, {**info, "files": [str(f) for f in files]}
+
 
 # --- commands: fold (solver) ---
 
@@ -384,6 +442,14 @@ def fold_cmd(
     ] = None,
     out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path("fold-out"),
     as_json: Annotated[bool, typer.Option("--json", help="Print the summary as JSON.")] = False,
+    form_only: Annotated[
+        bool,
+        typer.Option(
+            "--form-only",
+            help="Only the folded form is wanted: use rigid kinematics when the scene has "
+            "actuators only (exact, fastest), else the bar-and-hinge solver.",
+        ),
+    ] = False,
 ) -> None:
     """Fold a scene: solve it step by step, write the fold path and a summary."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
@@ -394,6 +460,16 @@ def fold_cmd(
     from barhinge.solve.outputs import summary, write_outputs
 
     scene = default_scene() if scene_file is None else load_scene(scene_file)
+    if form_only and form_only_model(scene)[0] == "rigid":
+        done = _fold_form_rigid(scene, out)
+        if done is not None:
+            if as_json:
+                print_json(done[1])
+            else:
+                console.print(f"fold --form-only: {scene.name} folded by rigid kinematics, "
+                              f"{done[1]['n_states']} states, {done[1]['wall_time_s']:.2f} s "
+                              f"-> {out}", highlight=False)  # fmt: skip
+            return
     bar = Progress(
         TextColumn(f"[bold]{scene.name}[/]"),
         BarColumn(),
@@ -617,11 +693,96 @@ def study(
 # --- commands: verify ---
 
 
+@app.command("verify")
+def verify_cmd(
+    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+    case: Annotated[
+        list[str] | None, typer.Option("--case", help="Run only this case (repeatable).")
+    ] = None,
+    quick: Annotated[bool, typer.Option("--quick", help="Only the fastest cases.")] = False,
+    list_cases: Annotated[bool, typer.Option("--list", help="List the cases and exit.")] = False,
+) -> None:
+    """Run the reference cases (closed forms from the literature); exit code 1 on a failure."""
+    from rich.table import Table
+
+    from barhinge import verify
+
+    if list_cases:
+        data = {
+            c.name: {
+                "citation": c.citation,
+                "description": c.description,
+                "quantities": [q.name for q in c.quantities],
+                "quick": c.quick,
+            }
+            for c in verify.CASES.values()
+        }
+        if as_json:
+            print_json(data)
+        else:
+            for name, d in data.items():
+                console.print(f"[bold]{name}[/] ({', '.join(d['quantities'])}): {d['citation']}",
+                              highlight=False, soft_wrap=True)  # fmt: skip
+        return
+    with err_console.status("verifying", spinner="dots") as status:
+
+        def on_case(c: verify.Case, rows: list) -> None:
+            if not as_json:
+                status.update(f"verifying: {c.name} done")
+
+        checks = verify.run(names=case or None, quick=quick, on_case=on_case)
+    info = verify.summary(checks)
+    if as_json:
+        print_json({**info, "checks": [c.as_dict() for c in checks]})
+    else:
+        t = Table(title="barhinge verify: reference cases")
+        for col, just in (
+            ("case", "left"),
+            ("quantity", "left"),
+            ("reference", "right"),
+            ("computed", "right"),
+            ("rel. error", "right"),
+            ("tolerance", "right"),
+            ("time (s)", "right"),
+            ("", "center"),
+        ):
+            t.add_column(col, justify=just, no_wrap=col in ("case", "quantity"))  # type: ignore[arg-type]
+        last = None
+        for c in checks:
+            t.add_row(
+                c.case if c.case != last else "",
+                c.quantity,
+                f"{c.reference:.7g}",
+                f"{c.computed:.7g}",
+                f"{c.error:.1e}",
+                f"{c.tolerance:.0e}",
+                f"{c.time_s:.2f}" if c.case != last else "",
+                "[green]pass[/]" if c.passed else "[bold red]FAIL[/]",
+            )
+            last = c.case
+        console.print(t)
+        seen: dict[str, str] = {}
+        for c in checks:
+            seen.setdefault(c.case, c.citation)
+        for name, cite in seen.items():
+            console.print(f"[dim]{name}:[/] {cite}", highlight=False, soft_wrap=True)
+        for c in checks:
+            if c.message:
+                console.print(f"[red]{c.case}/{c.quantity}:[/] {c.message}", highlight=False)
+        console.print(
+            f"{info['n_passed']}/{info['n_checks']} checks passed in {info['n_cases']} cases "
+            f"({info['time_s']:.1f} s)",
+            highlight=False,
+        )
+    if not info["passed"]:
+        raise SystemExit(1)
+
+
 def main() -> None:
     """Entry point: run the app, turning barhinge errors into one line and an exit code."""
     try:
-        app(standalone_mode=False)
-    except SystemExit as exc:  # typer/click exits (help, usage)
+        code = app(standalone_mode=False)  # returns the code of a typer.Exit
+    except SystemExit:  # typer/click exits (help, usage)
         raise
     except BarhingeError as exc:
         if _state["debug"]:
@@ -637,6 +798,8 @@ def main() -> None:
         if isinstance(exc, click.exceptions.Abort):
             sys.exit(1)
         raise
+    if isinstance(code, int) and code != 0:
+        sys.exit(code)
 
 
 if __name__ == "__main__":

@@ -306,16 +306,21 @@ def read_records(out: str | Path) -> dict[str, Record]:
     return recs
 
 
+_MAX_CELL = 1000  # longer non-scalar results stay in the point records only
+
+
 def _cell(v: Any) -> Any:
     if v is None or isinstance(v, str | int | float | bool):
         return v
-    return json.dumps(v, default=_json_default)
+    text = json.dumps(v, default=_json_default)
+    return text if len(text) <= _MAX_CELL else "(see points/<id>.json)"
 
 
 def write_summary(out: str | Path, points: Sequence[Point], records: dict[str, Record]) -> Path:
     """Write ``summary.csv`` (and ``summary.parquet`` if pyarrow exists): one row per point.
 
-    Columns: id, status, the parameters, the result's keys (non-scalar values as JSON; a key
+    Columns: id, status, the parameters, the result's keys (non-scalar values as JSON, or a
+    pointer to the record when longer than 1000 characters; a key
     that clashes with a parameter or a fixed column becomes ``result.<key>``), error_type,
     error_message, elapsed_s, worker. Points without a record have status "pending".
     """

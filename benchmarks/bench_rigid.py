@@ -54,22 +54,29 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=1, help="runs per size (median is kept)")
     args = ap.parse_args()
     rows = []
-    hdr = (f"{'cells':>7} {'creases':>8} {'int.vert':>8} {'setup s':>8} {'step1 s':>8} "
-           f"{'median ms/step':>15} {'p90 ms':>8} {'iters':>6} {'max closure':>12}")  # fmt: skip
+    hdr = (
+        f"{'cells':>7} {'creases':>8} {'int.vert':>8} {'setup s':>8} {'step1 s':>8} "
+        f"{'median ms/step':>15} {'p90 ms':>8} {'iters':>6} {'max closure':>12}"
+    )
     print(hdr)
     print("-" * len(hdr))
     for n in args.sizes:
         runs = [run(n, args.steps) for _ in range(args.repeat)]
         r = sorted(runs, key=lambda d: d["median_ms"])[len(runs) // 2]
         rows.append(r)
-        print(f"{r['cells']:>7} {r['creases']:>8d} {r['vertices']:>8d} {r['setup_s']:>8.2f} "
-              f"{r['first_s']:>8.2f} {r['median_ms']:>15.1f} {r['p90_ms']:>8.1f} "
-              f"{r['iters']:>6.1f} {r['closure']:>12.1e}", flush=True)  # fmt: skip
+        print(
+            f"{r['cells']:>7} {r['creases']:>8d} {r['vertices']:>8d} {r['setup_s']:>8.2f} "
+            f"{r['first_s']:>8.2f} {r['median_ms']:>15.1f} {r['p90_ms']:>8.1f} "
+            f"{r['iters']:>6.1f} {r['closure']:>12.1e}",
+            flush=True,
+        )
     if len(rows) >= 2:
         x = np.log([r["creases"] for r in rows])
         y = np.log([r["median_ms"] for r in rows])
-        print(f"\nscaling: time per step ~ creases^{np.polyfit(x, y, 1)[0]:.2f} "
-              f"(fit over {len(rows)} sizes)")  # fmt: skip
+        print(
+            f"\nscaling: time per step ~ creases^{np.polyfit(x, y, 1)[0]:.2f} "
+            f"(fit over {len(rows)} sizes)"
+        )
 
 
 if __name__ == "__main__":

@@ -46,6 +46,7 @@ __all__ = [
     "bar_strain_derivatives",
     "hinge_angle",
     "hinge_angle_gradient",
+    "hinge_angle_gradient_t",
     "hinge_angle_derivatives",
     "hinge_angle_hessian_packed",
     "hinge_energy_hessian_packed",
@@ -170,26 +171,9 @@ for _bi, _bj in _BLOCKS:
     _PACK[(_bi, _bj)] = (_sel, (TRIU12[0][_sel] % 3) * 3 + TRIU12[1][_sel] % 3)
 
 
-def _hinge_hessian_packed_t(X: np.ndarray, hinges: np.ndarray, law=None, out=None):
-    """Component-major fast path: ``rho (nh,)``, ``grad (12, nh)`` and the packed upper
-    triangle of the Hessian ``(78, nh)`` (``TRIU12`` order). Hinges are on the last axis of
-    every array, so each operation is a contiguous vector operation.
-
-    Block form (derived from the gradient of the module docstring): with
-    ``f_L = n_L/|n_L|^2``, ``s_L = |a|/|n_L|^2`` (same for R) and, per column node c,
-    ``v^L_c`` the vector with ``d n_L / d x_c = [v^L_c]x`` (``u - a, -u, a, 0`` for
-    ``i, j, k, l``; for ``n_R``: ``a - w, w, 0, -a``),
-    ``d g_k / d x_c = f_L (x) p^L_c + s_L [v^L_c]x`` with
-    ``p^L_c = d|a|/dx_c - 2 |a| f_L x v^L_c``; the rows of ``i`` and ``j`` follow from
-    ``g_i = -(1 - t_k) g_k - (1 - t_l) g_l`` and ``g_j = -t_k g_k - t_l g_l``. Every 3x3 block
-    is therefore ``f_L (x) alpha + f_R (x) beta + [sigma]x``, filled row by row of the
-    packed triangle (vectors of length nh that stay in cache).
-
-    With ``law`` (a callable ``rho -> (M, dM/drho, W)``) the packed result is the Hessian of
-    the hinge energy, ``M d2rho + (dM/drho) grad grad^T``, and ``(M, dM/drho, W)`` are
-    returned too; without it, the Hessian of ``rho`` and ``(None, None, None)``.
-    """
-    XT = np.ascontiguousarray(X.T)
+def _hinge_grad_t(XT: np.ndarray, hinges: np.ndarray):
+    """Component-major ``rho (nh,)``, ``grad (12, nh)`` and the intermediate quantities the
+    Hessian needs, from the coordinates ``XT`` (3, n_nodes)."""
     xi, xj, xk, xl = (XT[:, hinges[:, c]] for c in range(4))
     a = xj - xi
     u = xk - xi
@@ -203,81 +187,141 @@ def _hinge_hessian_packed_t(X: np.ndarray, hinges: np.ndarray, law=None, out=Non
     mR = (nR * nR).sum(0)
     fL = nL / mL
     fR = nR / mR
-    gk = la * fL
-    gl = la * fR
     tk = (u * a).sum(0) / aa
     tl = (w * a).sum(0) / aa
-    gi = -(1.0 - tk) * gk - (1.0 - tl) * gl
-    gj = -tk * gk - tl * gl
-    grad = np.concatenate([gi, gj, gk, gl], axis=0)  # (12, nh)
+    lam = (-(1.0 - tk) * la, -tk * la, la, None)  # grad block b = lam_b f_L + mu_b f_R
+    mu = (-(1.0 - tl) * la, -tl * la, None, la)
+    grad = np.empty((12, len(hinges)))
+    for b in range(4):
+        g = grad[3 * b : 3 * b + 3]
+        if lam[b] is not None:
+            np.multiply(lam[b], fL, out=g)
+            if mu[b] is not None:
+                g += mu[b] * fR
+        else:
+            np.multiply(mu[b], fR, out=g)
+    return rho, grad, (a, u, w, aa, la, mL, mR, fL, fR, tk, tl, lam, mu)
+
+
+def hinge_angle_gradient_t(
+    X: np.ndarray, hinges: np.ndarray, chunk: int = 16384
+) -> tuple[np.ndarray, np.ndarray]:
+    """Component-major ``(rho (nh,), grad (12, nh))`` (the force-only fast path)."""
+    XT = np.ascontiguousarray(X.T)
+    nh = len(hinges)
+    rho, grad = np.empty(nh), np.empty((12, nh))
+    for s0 in range(0, nh, chunk):
+        sl = slice(s0, min(s0 + chunk, nh))
+        rho[sl], grad[:, sl], _ = _hinge_grad_t(XT, hinges[sl])
+    return rho, grad
+
+
+def _hinge_hessian_packed_t(
+    XT: np.ndarray, hinges: np.ndarray, law=None, sl: slice | None = None, out=None
+):
+    """Component-major fast path on the coordinates ``XT`` (3, n_nodes): ``rho (nh,)``,
+    ``grad (12, nh)``, the packed upper triangle ``(78, nh)`` (``TRIU12`` order) and the law's
+    ``(M, dM/drho, W)`` (None without a law). Hinges are on the last axis of every array, so
+    each operation is a contiguous vector operation.
+
+    Block form (derived from the gradient of the module docstring): with
+    ``f_L = n_L/|n_L|^2``, ``s_L = |a|/|n_L|^2`` (same for R) and, per column node c,
+    ``v^L_c`` the vector with ``d n_L / d x_c = [v^L_c]x`` (``u - a, -u, a, 0`` for
+    ``i, j, k, l``; for ``n_R``: ``a - w, w, 0, -a``),
+    ``d g_k / d x_c = f_L (x) p^L_c + s_L [v^L_c]x`` with
+    ``p^L_c = d|a|/dx_c - 2 |a| f_L x v^L_c``; the rows of ``i`` and ``j`` follow from
+    ``g_i = -(1 - t_k) g_k - (1 - t_l) g_l`` and ``g_j = -t_k g_k - t_l g_l``. Every 3x3 block
+    is therefore ``f_L (x) alpha + f_R (x) beta + [sigma]x``. Since every gradient block is
+    ``lambda_b f_L + mu_b f_R`` too, the energy Hessian ``M d2rho + K grad grad^T`` keeps that
+    form (``alpha -> M alpha + K lambda_bi g_bj``, ...); it is filled row by row of the packed
+    triangle (vectors of length nh that stay in cache).
+
+    With ``law`` (``(rho, sl) -> (M, dM/drho, W)``, ``sl`` the slice of these hinges in the
+    model) the result is the Hessian of the hinge energy; without it, that of ``rho``.
+    """
+    rho, grad, (a, u, w, aa, la, mL, mR, fL, fR, tk, tl, lam, mu) = _hinge_grad_t(XT, hinges)
 
     sL = la / mL
     sR = la / mR
     ahat = a / la
     ia = a / aa
-    zero = np.zeros_like(a)
     vL = (u - a, -u, a, None)
     vR = (a - w, w, None, -a)
-    Dla = (-ahat, ahat, zero, zero)
-    Dtk = ((-a - u) / aa + 2.0 * tk * ia, u / aa - 2.0 * tk * ia, ia, zero)
-    Dtl = ((-a - w) / aa + 2.0 * tl * ia, w / aa - 2.0 * tl * ia, zero, ia)
+    Dla = (-ahat, ahat, None, None)
+    Dtk = ((-a - u) / aa + 2.0 * tk * ia, u / aa - 2.0 * tk * ia, ia, None)
+    Dtl = ((-a - w) / aa + 2.0 * tl * ia, w / aa - 2.0 * tl * ia, None, ia)
     twola = 2.0 * la
-    pL = [None if v is None else Dla[c] - twola * _cross_t(fL, v) for c, v in enumerate(vL)]
-    pR = [None if v is None else Dla[c] - twola * _cross_t(fR, v) for c, v in enumerate(vR)]
+
+    def p_of(f, v, c):
+        if v is None:
+            return None
+        t = -twola * _cross_t(f, v)
+        return t if Dla[c] is None else t + Dla[c]
+
+    pL = [p_of(fL, v, c) for c, v in enumerate(vL)]
+    pR = [p_of(fR, v, c) for c, v in enumerate(vR)]
 
     nh = len(hinges)
     if law is None:
         M = Kt = W = None
-        FL, FR, scale = fL, fR, 1.0
     else:
-        M, Kt, W = law(rho)
-        FL, FR, scale = M * fL, M * fR, M
-        Ktg = Kt * grad
+        M, Kt, W = law(rho, slice(None) if sl is None else sl)
     Hp = np.empty((78, nh)) if out is None else out
     tmp = np.empty(nh)
-    skew_sign = {(0, 1): (2, -1.0), (0, 2): (1, 1.0), (1, 0): (2, 1.0), (1, 2): (0, -1.0),
-                 (2, 0): (1, -1.0), (2, 1): (0, 1.0)}
+    skew_sign = {
+        (0, 1): (2, -1.0),
+        (0, 2): (1, 1.0),
+        (1, 0): (2, 1.0),
+        (1, 2): (0, -1.0),
+        (2, 0): (1, -1.0),
+        (2, 1): (0, 1.0),
+    }
+
+    def lin(*terms):
+        """Sum of the products in ``terms`` ((coef, vec) pairs; None entries skipped)."""
+        acc = None
+        for cf, v in terms:
+            if cf is None or v is None:
+                continue
+            t = cf * v
+            acc = t if acc is None else acc + t
+        return acc
 
     def put(bi: int, bj: int, alpha, beta, sigma) -> None:
+        if law is not None:
+            gb = grad[3 * bj : 3 * bj + 3]
+            alpha = lin((M, alpha), (None if lam[bi] is None else Kt * lam[bi], gb))
+            beta = lin((M, beta), (None if mu[bi] is None else Kt * mu[bi], gb))
+            sigma = None if sigma is None else M * sigma
         pos, ent = _PACK[(bi, bj)]
-        if sigma is not None and law is not None:
-            sigma = scale * sigma
         for p, e in zip(pos, ent, strict=True):
             r, c = divmod(int(e), 3)
-            out = Hp[p]
+            row = Hp[p]
             if alpha is not None:
-                np.multiply(FL[r], alpha[c], out=out)
+                np.multiply(fL[r], alpha[c], out=row)
             else:
-                out[...] = 0.0
+                row[...] = 0.0
             if beta is not None:
-                np.multiply(FR[r], beta[c], out=tmp)
-                out += tmp
+                np.multiply(fR[r], beta[c], out=tmp)
+                row += tmp
             if sigma is not None and (r, c) in skew_sign:
                 comp, sgn = skew_sign[(r, c)]
                 if sgn > 0:
-                    out += sigma[comp]
+                    row += sigma[comp]
                 else:
-                    out -= sigma[comp]
-            if law is not None:
-                np.multiply(Ktg[3 * bi + r], grad[3 * bj + c], out=tmp)
-                out += tmp
+                    row -= sigma[comp]
 
     def sig(cL, cR, c):
-        out = None
-        if vL[c] is not None:
-            out = cL * sL * vL[c]
-        if vR[c] is not None:
-            t = cR * sR * vR[c]
-            out = t if out is None else out + t
-        return out
+        return lin((None if vL[c] is None else cL * sL, vL[c]),
+                   (None if vR[c] is None else cR * sR, vR[c]))  # fmt: skip
 
     for c in range(4):  # row blocks of i (c >= 0) and j (c >= 1)
-        aL = la * Dtk[c] - ((1.0 - tk) * pL[c] if pL[c] is not None else 0.0)
-        aR = la * Dtl[c] - ((1.0 - tl) * pR[c] if pR[c] is not None else 0.0)
+        aL = lin((la, Dtk[c]), (-(1.0 - tk), pL[c]))
+        aR = lin((la, Dtl[c]), (-(1.0 - tl), pR[c]))
         put(0, c, aL, aR, sig(-(1.0 - tk), -(1.0 - tl), c))
         if c >= 1:
-            bL = -la * Dtk[c] - (tk * pL[c] if pL[c] is not None else 0.0)
-            bR = -la * Dtl[c] - (tl * pR[c] if pR[c] is not None else 0.0)
+            bL = lin((-la, Dtk[c]), (-tk, pL[c]))
+            bR = lin((-la, Dtl[c]), (-tl, pR[c]))
             put(1, c, bL, bR, sig(-tk, -tl, c))
     put(2, 2, pL[2], None, sL * a)
     put(2, 3, None, None, None)
@@ -301,7 +345,7 @@ def hinge_angle_derivatives(
     grad : (nh, 12) ``d rho / d (x_i, x_j, x_k, x_l)``, xyz interleaved per node.
     hess : (nh, 12, 12) symmetric second derivative, same ordering.
     """
-    rho, grad, Hp, _ = _hinge_hessian_packed_t(X, hinges)
+    rho, grad, Hp, _ = _hinge_hessian_packed_t(np.ascontiguousarray(X.T), hinges)
     iu, ju = TRIU12
     H = np.empty((len(hinges), 12, 12))
     H[:, iu, ju] = Hp.T
@@ -315,22 +359,35 @@ def hinge_angle_hessian_packed(
     """Like :func:`hinge_angle_derivatives` but component-major (the assembly's fast path):
     ``rho (nh,)``, ``grad (12, nh)`` and the packed upper triangle of the Hessian
     ``(78, nh)`` in ``numpy.triu_indices(12)`` order."""
-    rho, grad, Hp, _ = _hinge_hessian_packed_t(X, hinges)
+    rho, grad, Hp, _ = _hinge_hessian_packed_t(np.ascontiguousarray(X.T), hinges)
     return rho, grad, Hp
 
 
-def hinge_energy_hessian_packed(X: np.ndarray, hinges: np.ndarray, law, out=None):
+def hinge_energy_hessian_packed(
+    X: np.ndarray, hinges: np.ndarray, law, out: np.ndarray | None = None, chunk: int = 8192
+):
     """Fast path of the assembly: hinge energy derivatives, component-major.
 
     Parameters
     ----------
-    law : callable ``rho (nh,) -> (M, dM/drho, W)``, each (nh,)
+    law : callable ``(rho, sl) -> (M, dM/drho, W)``: the law of the hinges ``sl`` (a slice
+        of ``hinges``) at their angles ``rho``, each result of the slice's length
     out : optional (78, nh) float array to write the packed Hessian into
+    chunk : hinges per pass (keeps the working vectors in cache; a loop over chunks, not
+        elements)
 
     Returns
     -------
     rho (nh,), M (nh,), Kt (nh,), W (nh,), grad of rho (12, nh), packed upper triangle of the
     energy Hessian ``M d2rho/dX2 + Kt grad grad^T`` (78, nh) in ``TRIU12`` order.
     """
-    rho, grad, Hp, (M, Kt, W) = _hinge_hessian_packed_t(X, hinges, law, out)
+    nh = len(hinges)
+    XT = np.ascontiguousarray(X.T)
+    Hp = np.empty((78, nh)) if out is None else out
+    grad = np.empty((12, nh))
+    rho, M, Kt, W = (np.empty(nh) for _ in range(4))
+    for s0 in range(0, nh, chunk):
+        sl = slice(s0, min(s0 + chunk, nh))
+        r, g, _, (m, k, e) = _hinge_hessian_packed_t(XT, hinges[sl], law, sl, Hp[:, sl])
+        rho[sl], grad[:, sl], M[sl], Kt[sl], W[sl] = r, g, m, k, e
     return rho, M, Kt, W, grad, Hp

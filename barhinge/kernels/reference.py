@@ -132,7 +132,9 @@ def hinge_reference(xi, xj, xk, xl) -> tuple[float, np.ndarray, np.ndarray]:
     return rho, g, 0.5 * (H + H.T)
 
 
-def bar_reference(xa, xb, L0: float, measure: str = "green") -> tuple[float, np.ndarray, np.ndarray]:
+def bar_reference(
+    xa, xb, L0: float, measure: str = "green"
+) -> tuple[float, np.ndarray, np.ndarray]:
     """Strain, gradient (6,) and Hessian (6, 6) of one bar w.r.t. ``(x_a, x_b)``."""
     xa, xb = np.asarray(xa, float), np.asarray(xb, float)
     d = xb - xa

@@ -217,8 +217,10 @@ class RigidConstraints:
         ang = np.arctan2(np.linalg.norm(np.cross(u, w), axis=1), np.einsum("ij,ij->i", u, w))
         loop_alpha = np.zeros((len(loops), D))
         loop_alpha[loop_var >= 0] = ang
-        rho0 = np.radians(pat.state_fold_angles()[creases]) if not pat.is_flat else np.zeros(
-            len(creases)
+        rho0 = (
+            np.radians(pat.state_fold_angles()[creases])
+            if not pat.is_flat
+            else np.zeros(len(creases))
         )
         return cls(
             pattern=pat,
@@ -241,6 +243,23 @@ class RigidConstraints:
     @property
     def n_eq(self) -> int:
         return 3 * len(self.vertices)
+
+    @cached_property
+    def holes(self) -> int:
+        """Number of holes of the pattern: ``components - (V - E + F)`` (0 for disks). Loops
+        of faces around a hole are not constrained here (see the module docstring)."""
+        pat = self.pattern
+        used = np.unique(pat.edges.ravel())
+        if len(used) == 0:
+            return 0
+        from scipy.sparse.csgraph import connected_components
+
+        n = pat.n_vertices
+        E = pat.edges
+        G = sp.coo_matrix((np.ones(len(E)), (E[:, 0], E[:, 1])), shape=(n, n))
+        n_comp = connected_components(G, directed=False)[0] - (n - len(used))
+        chi = len(used) - len(E) + pat.n_faces
+        return max(int(n_comp - chi), 0)
 
     @cached_property
     def var_source_edge(self) -> np.ndarray:
@@ -297,18 +316,19 @@ class RigidConstraints:
         """
         nv, D = self.loop_var.shape
         r = np.where(self.loop_var >= 0, rho[np.maximum(self.loop_var, 0)], 0.0)
-        cr, sr = np.cos(r), np.sin(r)
-        ca, sa = self._cs_alpha
-        # M = Rx(rho) Rz(alpha) in closed form, (nv, D, 3, 3)
-        M = np.empty((nv, D, 3, 3))
-        M[..., 0, 0], M[..., 0, 1], M[..., 0, 2] = ca, -sa, 0.0
-        M[..., 1, 0], M[..., 1, 1], M[..., 1, 2] = cr * sa, cr * ca, -sr
-        M[..., 2, 0], M[..., 2, 1], M[..., 2, 2] = sr * sa, sr * ca, cr
-        F = np.broadcast_to(np.eye(3), (nv, 3, 3)).copy()
+        cr, sr = np.cos(r)[:, :, None], np.sin(r)[:, :, None]
+        ca, sa = (x[:, :, None] for x in self._cs_alpha)
+        # columns of the running product F, updated by F <- F Rx(rho_j) Rz(alpha_j)
+        c0 = np.zeros((nv, 3))
+        c1 = np.zeros((nv, 3))
+        c2 = np.zeros((nv, 3))
+        c0[:, 0] = c1[:, 1] = c2[:, 2] = 1.0
         A = np.empty((nv, D, 3))
         for j in range(D):
-            A[:, j] = F[:, :, 0]
-            F = F @ M[:, j]
+            A[:, j] = c0
+            c1, c2 = c1 * cr[:, j] + c2 * sr[:, j], c2 * cr[:, j] - c1 * sr[:, j]
+            c0, c1 = c0 * ca[:, j] + c1 * sa[:, j], c1 * ca[:, j] - c0 * sa[:, j]
+        F = np.stack([c0, c1, c2], axis=2)
         return F, A
 
     def residual(self, rho: np.ndarray) -> np.ndarray:
@@ -323,6 +343,11 @@ class RigidConstraints:
 
     def evaluate(self, rho: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix]:
         """Residual (3 n_cv,) and exact sparse Jacobian (3 n_cv, n_var) at ``rho``."""
+        r, J, _ = self.evaluate_full(rho)
+        return r, J
+
+    def evaluate_full(self, rho: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix, np.ndarray]:
+        """Residual, Jacobian and the loop products F (n_cv, 3, 3) at ``rho``."""
         F, A = self.loop_products(rho)
         r = _vee_skew(F).ravel()
         tr = np.trace(F, axis1=1, axis2=2)
@@ -331,7 +356,7 @@ class RigidConstraints:
         indptr, indices, order, vmask = self._pattern_csr
         data = cols[vmask][order]
         J = sp.csr_matrix((data, indices, indptr), shape=(self.n_eq, self.n_var))
-        return r, J
+        return r, J, F
 
     def jacobian(self, rho: np.ndarray) -> sp.csr_matrix:
         """(3 n_cv, n_var) exact sparse Jacobian ``dr/drho``."""
@@ -544,8 +569,10 @@ class NodalConstraints:
             rows_p = cols_p = np.zeros(0, dtype=np.int64)
             data_p = np.zeros(0)
         J = sp.csr_matrix(
-            (np.concatenate([data_b, data_p]), (np.concatenate([rows_b, rows_p]),
-                                                np.concatenate([cols_b, cols_p]))),
+            (
+                np.concatenate([data_b, data_p]),
+                (np.concatenate([rows_b, rows_p]), np.concatenate([cols_b, cols_p])),
+            ),
             shape=(self.n_eq, 3 * self.n_nodes),
         )
         return np.concatenate([rb, rp]), J

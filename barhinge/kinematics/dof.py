@@ -126,8 +126,12 @@ class DofReport:
                 "n_interior_vertices": r.n_interior_vertices,
                 "flat": r.flat,
                 "closure": r.closure,
-                "local_dof_histogram": {int(k): int(v) for k, v in zip(*np.unique(loc, return_counts=True), strict=True)},
-                "region_dof_histogram": {int(k): int(v) for k, v in zip(*np.unique(reg, return_counts=True), strict=True)},
+                "local_dof_histogram": {
+                    int(k): int(v) for k, v in zip(*np.unique(loc, return_counts=True), strict=True)
+                },
+                "region_dof_histogram": {
+                    int(k): int(v) for k, v in zip(*np.unique(reg, return_counts=True), strict=True)
+                },
                 "actuators": r.actuators.tolist(),
                 "note": r.note,
             }
@@ -179,12 +183,31 @@ def dof(
     rc = RigidConstraints.from_pattern(cp, triangulated=triangulated)
     rho = _state_angles(rc, state)
     rep = _report(rc, rho, prefer=prefer, tol=tol)
+    if rc.holes:
+        rep = dataclasses.replace(
+            rep,
+            note=_join(
+                rep.note,
+                f"the pattern has {rc.holes} hole(s): loops of panels around a hole are not "
+                "constrained, so the DOF may be over-estimated",
+            ),
+        )
     if rep.flat and folded_check and rc.n_var > 0:
         try:
             rho_f = folded_sample(rc)
         except PatternError as exc:
             return dataclasses.replace(rep, note=_join(rep.note, str(exc)))
         folded = _report(rc, rho_f, prefer=prefer, tol=tol)
+        wrong = _against_assignment(rc, rho_f)
+        if wrong:
+            folded = dataclasses.replace(
+                folded,
+                note=_join(
+                    folded.note,
+                    f"this folded state disagrees with the M/V assignment at {wrong} creases "
+                    "(the assigned mode may not be rigidly foldable)",
+                ),
+            )
         rep = dataclasses.replace(
             rep,
             folded=folded,
@@ -195,6 +218,15 @@ def dof(
             ),
         )
     return rep
+
+
+def _against_assignment(rc: RigidConstraints, rho: np.ndarray) -> int:
+    """Number of M/V creases folded (> 1e-6 rad) against their assignment."""
+    src = rc.var_source_edge
+    ok = src >= 0
+    asg = rc.source.assignment[src[ok]]
+    r = rho[ok]
+    return int(np.sum(((asg == "V") & (r < -1e-6)) | ((asg == "M") & (r > 1e-6))))
 
 
 def _join(a: str, b: str) -> str:
@@ -217,9 +249,7 @@ def _state_angles(rc: RigidConstraints, state: Any) -> np.ndarray:
     return rho
 
 
-def _report(
-    rc: RigidConstraints, rho: np.ndarray, *, prefer: Any, tol: float | None
-) -> DofReport:
+def _report(rc: RigidConstraints, rho: np.ndarray, *, prefer: Any, tol: float | None) -> DofReport:
     r, J = rc.evaluate(rho)
     ns = null_space(J, tol)
     n_faces_extra = 0 if rc.triangulated else sum(len(f) - 3 for f in rc.pattern.faces)
@@ -445,7 +475,9 @@ def _branch_direction(rc: RigidConstraints) -> np.ndarray:
     return np.where(asg == "V", 1.0, np.where(asg == "M", -1.0, 0.0))
 
 
-def folded_sample(rc: RigidConstraints, *, magnitude: float = 0.3, max_iter: int = 50) -> np.ndarray:
+def folded_sample(
+    rc: RigidConstraints, *, magnitude: float = 0.3, max_iter: int = 50
+) -> np.ndarray:
     """A rigidly folded state near the flat one.
 
     The branch direction (target angles, else M/V signs) is scaled to ``magnitude`` rad; the

@@ -6,10 +6,11 @@ Each requested step goes from the converged fold angles ``rho`` to new actuator 
 1. **Predictor** along the tangent of the constraint manifold: ``J_F d_F = -J_A dt`` (least
    squares through the normal equations; ``F`` = free creases, ``A`` = actuators).
 2. **Corrector**: Gauss-Newton ``(J_F^T J_F) d_F = -J_F^T r`` with the actuator angles held at
-   their targets, until ``max |r| <= tol`` and ``max |F - I| <= 100 tol``. The rows are
+   their targets, until ``max |r| <= tol`` and ``max |F - I|_max <= 100 tol``. The rows are
    redundant for most patterns (e.g. Miura), so the normal equations are used; the system
-   is consistent on the manifold, so Gauss-Newton converges quadratically. The factorisation
-   is reused while the contraction is fast and refreshed otherwise.
+   is consistent on the manifold, so Gauss-Newton converges quadratically. One sparse LU per
+   step; later iterations use it as a preconditioner for conjugate gradients on the current
+   normal equations (inexact Newton) and backtrack on ``|r|_2``.
 3. **Step control**: a step that does not converge is split in halves (cut-back), up to
    ``max_cutbacks`` times.
 
@@ -72,7 +73,7 @@ class RigidOptions:
     check_actuators : bool
         Check at the first folded state that the actuators determine the motion.
     check_rank : bool or None
-        Recompute the DOF (dense SVD) at every state; None = only when n_var <= 600.
+        Recompute the DOF (dense SVD) at every state; None = only when n_var <= 300.
     cg_maxiter : int
         Conjugate-gradient iterations allowed with a reused factorisation as preconditioner
         before the normal matrix is factorised afresh.
@@ -120,7 +121,13 @@ class RigidSolver:
         K = (J.T @ J).tocsr()
         Kf = self._Dfree @ K @ self._Dfree + self._Dact
         try:
-            self._lu = spla.splu(Kf.tocsc(), permc_spec="MMD_AT_PLUS_A")
+            # symmetric positive (semi)definite: symmetric ordering, no pivoting
+            self._lu = spla.splu(
+                Kf.tocsc(),
+                permc_spec="MMD_AT_PLUS_A",
+                diag_pivot_thresh=0.0,
+                options={"SymmetricMode": True},
+            )
         except RuntimeError as exc:  # exactly singular: free creases not determined
             raise _Singular(str(exc)) from None
 
@@ -130,66 +137,101 @@ class RigidSolver:
         x[~self.free] = 0.0
         return x
 
-    def _solve_current(self, J: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray:
+    def _solve_current(self, J: sp.csr_matrix, rhs: np.ndarray, eta: float) -> np.ndarray:
         """Solve the normal equations of the current Jacobian ``J``: preconditioned conjugate
-        gradients with the last factorisation as preconditioner (a handful of iterations
-        while the Jacobian changes little); refactorise when CG needs more than
-        ``opt.cg_maxiter`` iterations."""
+        gradients with the last factorisation as preconditioner, to relative accuracy ``eta``
+        (inexact Newton); refactorise when CG needs more than ``opt.cg_maxiter``
+        iterations."""
         if self._lu is None:
             self._factor(J)
             return self._solve(rhs)
         free = self.free
-        n = len(free)
-
-        def matvec(v: np.ndarray) -> np.ndarray:
-            w = np.where(free, v, 0.0)
-            return np.where(free, J.T @ (J @ w), v)
-
-        A = spla.LinearOperator((n, n), matvec=matvec, dtype=float)
-        M = spla.LinearOperator((n, n), matvec=self._solve, dtype=float)
         b = np.where(free, rhs, 0.0)
-        x, info = spla.cg(A, b, rtol=1e-10, atol=0.0, maxiter=self.opt.cg_maxiter, M=M)
-        if info != 0 or not np.all(np.isfinite(x)):
+        x = self._pcg(J, b, eta)
+        if x is None:
             self._factor(J)
             return self._solve(rhs)
-        x[~free] = 0.0
         return x
 
-    # ---------------------------------------------------------------- one step
+    def _pcg(self, J: sp.csr_matrix, b: np.ndarray, eta: float) -> np.ndarray | None:
+        """Preconditioned CG on ``D J^T J D x = b`` (free creases), preconditioner = the
+        stored factorisation; None if ``opt.cg_maxiter`` iterations do not reach ``|res| <=
+        eta |b|``. Plain NumPy reductions (no BLAS calls on small vectors)."""
+        free = self.free
+
+        def dot(u: np.ndarray, v: np.ndarray) -> float:
+            return float((u * v).sum())
+
+        def A(v: np.ndarray) -> np.ndarray:
+            return np.where(free, J.T @ (J @ np.where(free, v, 0.0)), 0.0)
+
+        bnorm = np.sqrt(dot(b, b))
+        if bnorm == 0.0:
+            return np.zeros_like(b)
+        x = np.zeros_like(b)
+        r = b.copy()
+        z = self._solve(r)
+        p = z.copy()
+        rz = dot(r, z)
+        for _ in range(self.opt.cg_maxiter):
+            Ap = A(p)
+            pAp = dot(p, Ap)
+            if not pAp > 0.0:
+                return None
+            alpha = rz / pAp
+            x += alpha * p
+            r -= alpha * Ap
+            if np.sqrt(dot(r, r)) <= eta * bnorm:
+                return x
+            z = self._solve(r)
+            rz_new = dot(r, z)
+            p = z + (rz_new / rz) * p
+            rz = rz_new
+        return None
+
     def corrector(self, rho: np.ndarray) -> tuple[np.ndarray, list[float], bool]:
         """Gauss-Newton with the actuators held; returns (rho, residual history, ok).
 
-        Each linear solve uses the current Jacobian (PCG preconditioned by the last
-        factorisation, see :meth:`_solve_current`), so the iteration is Newton-like
-        (quadratic) while the factorisation is refreshed only when needed."""
+        The normal matrix is factorised once per call (at the first iteration); later
+        iterations solve with the current Jacobian by PCG preconditioned by that
+        factorisation (:meth:`_solve_current`), so the iteration stays Newton-like
+        (quadratic) for the price of one factorisation per step."""
         tol = self.opt.tol
         hist: list[float] = []
+        r, J, F = self.rc.evaluate_full(rho)
         for it in range(self.opt.max_iter + 1):
-            r, J = self.rc.evaluate(rho)
             res = float(np.max(np.abs(r), initial=0.0))
             hist.append(res)
             if not np.isfinite(res):
                 return rho, hist, False
             if res <= tol:
-                if len(self.rc.vertices) == 0 or self.rc.closure_error(rho).max() <= 100 * tol:
+                # |F - I| also rejects the spurious 180-degree loops where r = 0
+                if len(F) == 0 or float(np.abs(F - np.eye(3)).max()) <= 100 * tol:
                     return rho, hist, True
-                return rho, hist, False  # closed on a spurious 180-degree loop
+                return rho, hist, False
             if it == self.opt.max_iter:
                 break
             if len(hist) >= 3 and res > 2.0 * hist[-2]:
                 return rho, hist, False  # diverging
-            step = self._solve_current(J, -(J.T @ r))
+            # forcing term: inexact Newton stays (nearly) quadratic with eta ~ |r|
+            eta = float(np.clip(10.0 * res, 1e-10, 1e-2))
+            if it == 0:
+                # near the flat state the small singular values of J move fast: a reused
+                # factorisation from the previous step is a poor preconditioner
+                self._factor(J)
+            step = self._solve_current(J, -(J.T @ r), eta)
             if not np.all(np.isfinite(step)):
                 return rho, hist, False
             smax = np.max(np.abs(step), initial=0.0)
             if smax > 0.5:  # trust region: at most ~30 deg per iteration
                 step *= 0.5 / smax
-            n0 = np.linalg.norm(r)  # backtrack on |r|_2 (Gauss-Newton descends it)
+            n0 = float((r * r).sum())  # backtrack on |r|_2 (Gauss-Newton descends it)
             for _ in range(6):
-                if np.linalg.norm(self.rc.residual(rho + step)) < n0:
+                r_t, J_t, F_t = self.rc.evaluate_full(rho + step)
+                if float((r_t * r_t).sum()) < n0:
                     break
                 step *= 0.5
-            rho = rho + step
+            rho, r, J, F = rho + step, r_t, J_t, F_t
             self.iterations += 1
         return rho, hist, False
 
@@ -230,7 +272,7 @@ class RigidSolver:
         mu = None
         eye = sp.identity(self.rc.n_var, format="csr")
         for _ in range(200):
-            if np.max(np.abs(r), initial=0.0) <= 1e-3 * self.opt.tol ** 0.25:
+            if np.max(np.abs(r), initial=0.0) <= 1e-3 * self.opt.tol**0.25:
                 break
             K = (J.T @ J).tocsr()
             if mu is None:
@@ -340,7 +382,13 @@ def rigid_fold(
         steps = len(act.table_deg)
     sched = np.radians(act.schedule(steps, start_deg=np.degrees(rho[av])))
     solver = RigidSolver(rc, av, opt)
-    check_rank = opt.check_rank if opt.check_rank is not None else rc.n_var <= 600
+    if rc.holes:
+        log.warning(
+            "the pattern has %d hole(s): loops of panels around holes are not constrained; "
+            "the rigid path may open them",
+            rc.holes,
+        )
+    check_rank = opt.check_rank if opt.check_rank is not None else rc.n_var <= 300
 
     t0 = time.perf_counter()
     states = [rho.copy()]
@@ -360,14 +408,17 @@ def rigid_fold(
         dofs.append(dof_at(rho))
 
     def partial(msg: str) -> FoldPath:
-        return _make_path(rc, cp, act, sched, states, iters, hists, walls, False, msg, dofs,
-                          events, opt)  # fmt: skip
+        return _make_path(
+            rc, cp, act, sched, states, iters, hists, walls, False, msg, dofs, events, opt
+        )
 
     for s in range(1, steps + 1):
         solver.iterations = 0
         hist_all: list[float] = []
-        check_misfit = opt.check_actuators and not checked and not (
-            np.max(np.abs(rho), initial=0.0) < FLAT_TOL
+        check_misfit = (
+            opt.check_actuators
+            and not checked
+            and not (np.max(np.abs(rho), initial=0.0) < FLAT_TOL)
         )
         try:
             ok, rho_new, over = _advance(
@@ -376,10 +427,17 @@ def rigid_fold(
         except _Singular:
             x = solver.last_guess if solver.last_guess is not None else rho
             _check_actuators(rc, x, av, act.edges)
-            msg = (f"step {s}: the Jacobian of the free creases is singular (a bifurcation "
-                   f"point or actuators that leave free motions)")  # fmt: skip
-            raise ConvergenceError(msg, step=s - 1, load_factor=(s - 1) / steps,
-                                   residuals=hist_all, last_state=partial(msg)) from None
+            msg = (
+                f"step {s}: the Jacobian of the free creases is singular (a bifurcation "
+                f"point or actuators that leave free motions)"
+            )
+            raise ConvergenceError(
+                msg,
+                step=s - 1,
+                load_factor=(s - 1) / steps,
+                residuals=hist_all,
+                last_state=partial(msg),
+            ) from None
         if not ok and over < 0 and np.max(np.abs(rho), initial=0.0) >= FLAT_TOL:
             # would the tangent towards the target carry a crease past +-180 deg?
             try:
@@ -394,19 +452,28 @@ def rigid_fold(
             e = int(rc.var_source_edge[worst])
             ang = float(np.degrees(rho_new[worst]))
             if over >= 0:
-                msg = (f"step {s}: locked: crease edge {e} (at {ang:.3f} deg) would pass "
-                       f"+-180 deg before the actuators reach their targets (panels meet)")  # fmt: skip
+                msg = (
+                    f"step {s}: locked: crease edge {e} (at {ang:.3f} deg) would pass "
+                    f"+-180 deg before the actuators reach their targets (panels meet)"
+                )
             elif abs(ang) > 170.0:
-                msg = (f"step {s}: locked: crease edge {e} is at {ang:.3f} deg, the panels meet "
-                       f"before the actuator targets")  # fmt: skip
+                msg = (
+                    f"step {s}: locked: crease edge {e} is at {ang:.3f} deg, the panels meet "
+                    f"before the actuator targets"
+                )
             else:
                 flat = np.max(np.abs(rho), initial=0.0) < FLAT_TOL
-                hint = (" leaving the flat state along the M/V assignment; the actuators may "
-                        "over-determine the motion or the pattern may not be rigidly foldable"
-                        if flat else "")  # fmt: skip
-                msg = (f"step {s}: the loop-closure residual did not close (last "
-                       f"{hist_all[-1] if hist_all else float('nan'):.2e} > {opt.tol:.0e}) after "
-                       f"{opt.max_cutbacks} cut-backs{hint}")  # fmt: skip
+                hint = (
+                    " leaving the flat state along the M/V assignment; the actuators may "
+                    "over-determine the motion or the pattern may not be rigidly foldable"
+                    if flat
+                    else ""
+                )
+                msg = (
+                    f"step {s}: the loop-closure residual did not close (last "
+                    f"{hist_all[-1] if hist_all else float('nan'):.2e} > {opt.tol:.0e}) after "
+                    f"{opt.max_cutbacks} cut-backs{hint}"
+                )
             raise ConvergenceError(
                 msg,
                 step=s - 1,
@@ -422,10 +489,13 @@ def rigid_fold(
             iters.append(solver.iterations)
             hists.append(tuple(hist_all))
             walls.append(time.perf_counter() - t0)
-            msg = (f"step {s}: locked: crease edge {e} reached {np.degrees(rho[worst]):.3f} deg "
-                   f"(+-180 deg: the panels meet)")  # fmt: skip
-            raise ConvergenceError(msg, step=s - 1, load_factor=s / steps,
-                                   residuals=hist_all, last_state=partial(msg))  # fmt: skip
+            msg = (
+                f"step {s}: locked: crease edge {e} reached {np.degrees(rho[worst]):.3f} deg "
+                f"(+-180 deg: the panels meet)"
+            )
+            raise ConvergenceError(
+                msg, step=s - 1, load_factor=s / steps, residuals=hist_all, last_state=partial(msg)
+            )
         if opt.check_actuators and not checked and np.max(np.abs(rho)) >= FLAT_TOL:
             _check_actuators(rc, rho, av, act.edges)
             checked = True
@@ -439,8 +509,7 @@ def rigid_fold(
                 ev = f"step {s}: DOF changed from {dofs[-2]} to {dofs[-1]} (singular state)"
                 events.append(ev)
                 log.warning(ev)
-    return _make_path(rc, cp, act, sched, states, iters, hists, walls, True, "", dofs, events,
-                      opt)  # fmt: skip
+    return _make_path(rc, cp, act, sched, states, iters, hists, walls, True, "", dofs, events, opt)
 
 
 def _advance(
@@ -527,12 +596,16 @@ def _check_actuators(
             f"state: {k - r} free motion(s) remain; drive e.g. edges {sug.tolist()}"
         )
     if len(av) > r:
-        log.info("actuators %s over-determine the motion (DOF %d): targets must stay compatible",
-                 edges.tolist(), k)  # fmt: skip
+        log.info(
+            "actuators %s over-determine the motion (DOF %d): targets must stay compatible",
+            edges.tolist(),
+            k,
+        )
 
 
-def _make_path(rc, cp, act, sched, states, iters, hists, walls, converged, msg, dofs, events,
-               opt) -> FoldPath:  # fmt: skip
+def _make_path(
+    rc, cp, act, sched, states, iters, hists, walls, converged, msg, dofs, events, opt
+) -> FoldPath:
     R = np.asarray(states)
     n = len(R)
     X = np.stack([rc.coordinates(r) for r in R])
@@ -545,6 +618,7 @@ def _make_path(rc, cp, act, sched, states, iters, hists, walls, converged, msg, 
         "tol": opt.tol,
         "dof": dofs,
         "events": events,
+        "holes": rc.holes,
     }
     return FoldPath(
         X=X,

@@ -26,6 +26,7 @@ Sources
 from __future__ import annotations
 
 import dataclasses
+import logging
 
 import numpy as np
 from scipy.optimize import lsq_linear
@@ -34,6 +35,8 @@ from barhinge.errors import ConfigError
 from barhinge.model.topology import Topology
 from barhinge.model.triangulate import Triangulation
 from barhinge.pattern.crease import CreasePattern
+
+logger = logging.getLogger(__name__)
 
 __all__ = [
     "Material",
@@ -108,7 +111,11 @@ def fold_stiffness(
             raise ConfigError(f"fold_stiffness = {fold_stiffness}; expected >= 0")
         k = float(fold_stiffness)
     else:
-        Ls = DEFAULT_LSTAR_OVER_T * material.t if crease_length_scale is None else crease_length_scale
+        Ls = (
+            DEFAULT_LSTAR_OVER_T * material.t
+            if crease_length_scale is None
+            else crease_length_scale
+        )
         if not Ls > 0:
             raise ConfigError(f"crease_length_scale = {Ls}; expected > 0")
         k = material.bending_rigidity / Ls
@@ -152,35 +159,43 @@ def plate_bend_scale(
     from barhinge.model.model import BarHingeModel
 
     X = cp.vertices3d
+    faces = np.asarray(faces, dtype=np.int64)
     out = np.ones(len(faces))
-    cache: dict[bytes, float] = {}
-    for n, f in enumerate(faces):
-        loop = list(cp.faces[f])
-        P3 = X[loop]
-        e1, e2, _ = _face_frames(X, cp.faces, np.array([f]))
-        Q = np.column_stack([(P3 - P3[0]) @ e1[0], (P3 - P3[0]) @ e2[0]])
-        key = np.round(Q / np.abs(Q).max(), 9).tobytes() + bytes(str(len(loop)), "ascii")
-        if key not in cache:
-            k = len(loop)
+    sizes = np.array([len(cp.faces[f]) for f in faces], dtype=np.int64)
+    for k in np.unique(sizes):
+        sel = np.flatnonzero(sizes == k)
+        F = np.array([cp.faces[f] for f in faces[sel]], dtype=np.int64)
+        e1, e2, _ = _face_frames(X, cp.faces, faces[sel])
+        P3 = X[F] - X[F[:, :1]]
+        Q = np.stack([np.einsum("nki,ni->nk", P3, e1), np.einsum("nki,ni->nk", P3, e2)], axis=2)
+        scale = np.abs(Q).max(axis=(1, 2))
+        key = np.round(Q.reshape(len(sel), -1) / scale[:, None], 9)
+        _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
+        vals = np.empty(len(first))
+        for u, f in enumerate(first):
+            Qf = Q[f]
             panel = CreasePattern(
-                Q, [[i, (i + 1) % k] for i in range(k)], ["B"] * k, faces=[list(range(k))]
+                Qf, [[i, (i + 1) % k] for i in range(k)], ["B"] * k, faces=[list(range(k))]
             )
             m = BarHingeModel.from_pattern(
                 panel, scheme, material, bend_calibration="kirchhoff", fold_stiffness=0.0
             )
             Sb = panel_corner_stiffness(m, np.arange(k))
-            Sp = plate_corner_stiffness(Q, material, refine)
-            cache[key] = float(np.trace(Sp) / np.trace(Sb)) if np.trace(Sb) > 0 else 1.0
-        out[n] = cache[key]
+            Sp = plate_corner_stiffness(Qf, material, refine)
+            vals[u] = float(np.trace(Sp) / np.trace(Sb)) if np.trace(Sb) > 0 else 1.0
+        out[sel] = vals[inv.ravel()]
+    logger.debug("plate bending calibration: %d faces", len(faces))
     return out
 
 
 def face_areas(cp: CreasePattern, X: np.ndarray) -> np.ndarray:
     """(n_faces,) area of each face (Newell), in the geometry X (first nodes = vertices)."""
     out = np.zeros(cp.n_faces)
-    for f, loop in enumerate(cp.faces):
-        P = X[list(loop)]
-        out[f] = 0.5 * np.linalg.norm(np.cross(P, np.roll(P, -1, axis=0)).sum(axis=0))
+    sizes = np.array([len(f) for f in cp.faces], dtype=np.int64)
+    for k in np.unique(sizes):
+        sel = np.flatnonzero(sizes == k)
+        P = X[np.array([cp.faces[f] for f in sel], dtype=np.int64)]  # (nf, k, 3)
+        out[sel] = 0.5 * np.linalg.norm(np.cross(P, np.roll(P, -1, axis=1)).sum(axis=1), axis=1)
     return out
 
 
@@ -226,8 +241,13 @@ def _bounded_fits(G: np.ndarray, y: np.ndarray, a_min: np.ndarray) -> np.ndarray
     area (so a symmetric panel gets a symmetric answer). Faces of the same shape are solved
     once (keyed on the rounded problem)."""
     scale = np.abs(G).max(axis=(1, 2))
-    key = np.round(np.concatenate([G.reshape(len(G), -1) / scale[:, None],
-                                   y / scale[:, None], (a_min / scale)[:, None]], axis=1), 9)
+    key = np.round(
+        np.concatenate(
+            [G.reshape(len(G), -1) / scale[:, None], y / scale[:, None], (a_min / scale)[:, None]],
+            axis=1,
+        ),
+        9,
+    )
     _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
     out = np.empty((len(first), G.shape[2]))
     for u, f in enumerate(first):

@@ -20,9 +20,10 @@ from barhinge._typing import SCHEMES, Scheme, StrainMeasure
 from barhinge.assembly import Assembler
 from barhinge.errors import ConfigError
 from barhinge.kernels.geometry import (
+    bar_strain,
     bar_strain_derivatives,
     hinge_angle,
-    hinge_angle_gradient,
+    hinge_angle_gradient_t,
     hinge_energy_hessian_packed,
 )
 from barhinge.kernels.laws import bar_linear, hinge_linear, hinge_penetration
@@ -33,8 +34,10 @@ from barhinge.model.calibrate import (
     bend_stiffness,
     bend_stiffness_kirchhoff,
     face_areas,
-    fold_stiffness as _fold_stiffness,
     plate_bend_scale,
+)
+from barhinge.model.calibrate import (
+    fold_stiffness as _fold_stiffness,
 )
 from barhinge.model.topology import build_topology
 from barhinge.model.triangulate import triangulate
@@ -44,10 +47,16 @@ __all__ = ["BarHingeModel", "Evaluation", "FOLD_LAWS"]
 
 FOLD_LAWS = ("linear", "penetration")
 
-# packed upper triangle of a bar's 6x6 [[k, -k], [-k, k]]: source entry of the 3x3 k, sign
+# packed upper triangle of a bar's 6x6 [[k, -k], [-k, k]]: which of the 6 distinct entries
+# of the symmetric 3x3 k (_SYM3) each packed entry holds, with which sign; _BAR_FIRST[q] is
+# the first packed entry holding +k[q] (computed there, copied to the others)
 _r6, _c6 = np.triu_indices(6)
-_BAR_SRC = (_r6 % 3) * 3 + (_c6 % 3)
+_SYM3 = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)]
+_BAR_Q = np.array(
+    [_SYM3.index((min(a % 3, b % 3), max(a % 3, b % 3))) for a, b in zip(_r6, _c6, strict=True)]
+)
 _BAR_SIGN = np.where((_r6 < 3) == (_c6 < 3), 1.0, -1.0)
+_BAR_FIRST = [int(np.flatnonzero((_BAR_Q == q) & (_BAR_SIGN > 0))[0]) for q in range(6)]
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -266,12 +275,15 @@ class BarHingeModel:
             if isinstance(kw[name], np.ndarray):
                 val = np.array(val, dtype=kw[name].dtype)
                 if val.shape != kw[name].shape:
-                    raise ConfigError(
-                        f"{name} must have shape {kw[name].shape}, got {val.shape}"
-                    )
+                    raise ConfigError(f"{name} must have shape {kw[name].shape}, got {val.shape}")
                 val = _ro(val)
             kw[name] = val
-        return BarHingeModel(**kw)
+        new = BarHingeModel(**kw)
+        # same connectivity: share the (expensive) scatter maps
+        if "assembler" in self.__dict__ and "bars" not in changes and "hinges" not in changes:
+            if len(new.X0) == len(self.X0):
+                new.__dict__["assembler"] = self.__dict__["assembler"]
+        return new
 
     def stiffened(self, ratio: float) -> BarHingeModel:
         """A new model with bar EA and bending stiffness multiplied by ``ratio``."""
@@ -326,12 +338,22 @@ class BarHingeModel:
         return Assembler(self.n_nodes, [self.bars, self.hinges])
 
     # ------------------------------------------------------------------ evaluation
-    def _hinge_law(self, rho: np.ndarray):
-        M, Kt, W = hinge_linear(rho, self.rest_angle, self.hinge_k)
+    @cached_property
+    def _limits_all(self) -> tuple[np.ndarray, np.ndarray]:
+        lo = np.full(self.n_hinges, -np.inf)
+        hi = np.full(self.n_hinges, np.inf)
+        lo[self._is_fold], hi[self._is_fold] = self.fold_limits_per_hinge
+        return _ro(lo), _ro(hi)
+
+    def _hinge_law(self, rho: np.ndarray, sl: slice = slice(None)):
+        """(M, dM/drho, W) of the hinges ``sl`` at the angles ``rho``."""
+        M, Kt, W = hinge_linear(rho, self.rest_angle[sl], self.hinge_k[sl])
         if self.fold_law == "penetration":
-            f = self._is_fold
-            lo, hi = self.fold_limits_per_hinge
-            Mf, Kf, Wf = hinge_penetration(rho[f], self.rest_angle[f], self.hinge_k[f], lo, hi)
+            f = self._is_fold[sl]
+            lo, hi = (v[sl][f] for v in self._limits_all)
+            Mf, Kf, Wf = hinge_penetration(
+                rho[f], self.rest_angle[sl][f], self.hinge_k[sl][f], lo, hi
+            )
             M[f], Kt[f], W[f] = Mf, Kf, Wf
         return M, Kt, W
 
@@ -363,16 +385,21 @@ class BarHingeModel:
             # g (12, nh), Hp (78, nh): packed upper triangle of the hinge energy Hessian
             rho, M, Kt, Wh, g, _ = hinge_energy_hessian_packed(X, hinges, self._hinge_law, Hp)
         else:
-            rho, g = hinge_angle_gradient(X, hinges)
-            g = g.T
+            rho, g = hinge_angle_gradient_t(X, hinges)
             M, Kt, Wh = self._hinge_law(rho)
         force = asm.force([fe_bar, M * g])
         K = None
         if tangent:
-            # bar: [[k, -k], [-k, k]] with k = S'' d d^T + S B, packed upper triangle of 6x6
-            kb = dS[:, None, None] * d[:, :, None] * d[:, None, :] + S[:, None, None] * B
-            kb = kb.reshape(len(bars), 9).T
-            np.multiply(kb[_BAR_SRC], _BAR_SIGN[:, None], out=Kb)
+            # bar: [[k, -k], [-k, k]] with k = S'' d d^T + S B, packed upper triangle of 6x6;
+            # the 6 distinct entries of the symmetric 3x3 k, component-major
+            dT = np.ascontiguousarray(d.T)
+            for q, (a, b) in enumerate(_SYM3):
+                row = Kb[_BAR_FIRST[q]]
+                np.multiply(dS * dT[a], dT[b], out=row)
+                row += S * B[:, a, b]
+            for p_, (q, sgn) in enumerate(zip(_BAR_Q, _BAR_SIGN, strict=True)):
+                if p_ != _BAR_FIRST[q]:
+                    np.multiply(Kb[_BAR_FIRST[q]], sgn, out=Kb[p_])
             K = asm.matrix_packed(flat)
         f = self._is_fold
         return Evaluation(
@@ -389,13 +416,17 @@ class BarHingeModel:
 
     def energy(self, X: np.ndarray) -> float:
         """Total stored energy at ``X``."""
-        X = self._check_X(X)
-        from barhinge.kernels.geometry import bar_strain
+        Wb, Wh = self.element_energies(X)
+        return float(Wb.sum() + Wh.sum())
 
+    def element_energies(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Stored energy of every bar ``(n_bars,)`` and every hinge ``(n_hinges,)`` at ``X``,
+        with the model's own laws (per-hinge penetration limits included)."""
+        X = self._check_X(X)
         eps = bar_strain(X, self.bars, self.bar_L0, self.strain)
         _, _, Wb = bar_linear(eps, self.bar_EA, self.bar_L0)
         _, _, Wh = self._hinge_law(hinge_angle(X, self.hinges))
-        return float(Wb.sum() + Wh.sum())
+        return Wb, Wh
 
     def internal_force(self, X: np.ndarray) -> np.ndarray:
         """(n_dof,) internal force ``dE/dX``."""

@@ -18,7 +18,7 @@ import dataclasses
 import numpy as np
 
 from barhinge._typing import SCHEMES, Scheme
-from barhinge.errors import ConfigError
+from barhinge.errors import ConfigError, PatternError
 from barhinge.pattern.crease import CreasePattern
 
 __all__ = ["Triangulation", "triangulate"]
@@ -92,9 +92,21 @@ def triangulate(cp: CreasePattern, scheme: Scheme = "N5B8") -> Triangulation:
     triangles = np.vstack(tris) if tris else np.zeros((0, 3), dtype=np.int64)
     tri_face = np.concatenate(tface) if tface else np.zeros(0, dtype=np.int64)
     order = np.argsort(tri_face, kind="stable")
+    triangles, tri_face = triangles[order], tri_face[order]
+    if len(triangles):
+        P = X0[triangles]
+        area2 = np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1)
+        scale = max(float(np.ptp(X0, axis=0).max()), 1e-300)
+        bad = np.flatnonzero(area2 <= 1e-12 * scale * scale)
+        if len(bad):
+            t = int(bad[0])
+            raise PatternError(
+                f"face {int(tri_face[t])} gives a degenerate (zero-area) triangle "
+                f"{triangles[t].tolist()} in {scheme}; expected non-degenerate faces"
+            )
     return Triangulation(
         X0=X0,
-        triangles=triangles[order],
-        tri_face=tri_face[order],
+        triangles=triangles,
+        tri_face=tri_face,
         centre_face=np.concatenate(cface) if cface else np.zeros(0, dtype=np.int64),
     )

@@ -211,20 +211,43 @@ class CreasePattern:
     def edge_faces(self) -> np.ndarray:
         """(m, 2) int: face on the left of the directed edge ``edges[e,0] -> edges[e,1]``
         (column 0) and on the right (column 1); -1 where there is none."""
+        # vectorised over all face sides (same result and errors as a loop over the faces;
+        # for a repeated vertex pair the last edge id wins, as in ``edge_index``)
         EF = -np.ones((self.n_edges, 2), dtype=np.int64)
-        idx = self.edge_index
-        for fi, f in enumerate(self.faces):
-            for a, b in zip(f, f[1:] + f[:1], strict=True):
-                e = idx.get((min(a, b), max(a, b)))
-                if e is None:
-                    raise PatternError(f"face {fi} uses side ({a}, {b}), which is not an edge")
-                col = 0 if self.edges[e, 0] == a else 1
-                if EF[e, col] != -1:
-                    raise PatternError(
-                        f"edge {e} ({a}, {b}) is traversed in the same direction by faces "
-                        f"{EF[e, col]} and {fi}: non-manifold or inconsistent orientation"
-                    )
-                EF[e, col] = fi
+        faces = self.faces
+        if not faces:
+            return _readonly(EF)
+        lens = np.fromiter((len(f) for f in faces), dtype=np.int64, count=len(faces))
+        a = np.fromiter((v for f in faces for v in f), dtype=np.int64, count=int(lens.sum()))
+        start = np.repeat(np.cumsum(lens) - lens, lens)
+        pos = np.arange(len(a)) - start
+        b = a[start + (pos + 1) % np.repeat(lens, lens)]
+        fid = np.repeat(np.arange(len(faces)), lens)
+        n = max(self.n_vertices, 1)
+        E = self.edges
+        key_e = np.minimum(E[:, 0], E[:, 1]) * n + np.maximum(E[:, 0], E[:, 1])
+        order = np.lexsort((np.arange(len(E)), key_e))
+        ks = key_e[order]
+        last = np.r_[ks[1:] != ks[:-1], True] if len(ks) else np.zeros(0, bool)
+        ks, eid = ks[last], order[last]
+        key_h = np.minimum(a, b) * n + np.maximum(a, b)
+        at = np.minimum(np.searchsorted(ks, key_h), max(len(ks) - 1, 0))
+        found = ks[at] == key_h if len(ks) else np.zeros(len(a), bool)
+        if not found.all():
+            k = int(np.flatnonzero(~found)[0])
+            raise PatternError(f"face {fid[k]} uses side ({a[k]}, {b[k]}), which is not an edge")
+        e = eid[at]
+        col = np.where(E[e, 0] == a, 0, 1)
+        slot = e * 2 + col
+        srt = np.argsort(slot, kind="stable")
+        dup = np.flatnonzero(slot[srt][1:] == slot[srt][:-1])
+        if len(dup):
+            first, second = srt[dup[0]], srt[dup[0] + 1]
+            raise PatternError(
+                f"edge {e[second]} ({a[second]}, {b[second]}) is traversed in the same direction "
+                f"by faces {fid[first]} and {fid[second]}: non-manifold or inconsistent orientation"
+            )
+        EF[e, col] = fid
         return _readonly(EF)
 
     @cached_property
@@ -305,16 +328,18 @@ class CreasePattern:
     @cached_property
     def face_corner_angles(self) -> tuple[np.ndarray, ...]:
         """Per face, the interior angle (radians) at each corner of its loop, in the current
-        geometry."""
+        geometry: measured counter-clockwise about the face normal, so a reflex corner of a
+        non-convex face is more than pi."""
         X = self.vertices3d
+        N = self.face_normals
         out = []
-        for f in self.faces:
+        for fi, f in enumerate(self.faces):
             P = X[list(f)]
             u = np.roll(P, -1, axis=0) - P
             w = np.roll(P, 1, axis=0) - P
             c = np.einsum("ij,ij->i", u, w)
-            s = np.linalg.norm(np.cross(u, w), axis=1)
-            out.append(_readonly(np.arctan2(s, c)))
+            s = np.cross(u, w) @ N[fi]
+            out.append(_readonly(np.mod(np.arctan2(s, c), 2 * np.pi)))
         return tuple(out)
 
     @cached_property

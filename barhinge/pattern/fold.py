@@ -181,7 +181,12 @@ def _orient_faces(V: np.ndarray, faces: list[list[int]]) -> tuple[list[list[int]
 
 
 def fold_dict_to_pattern(
-    data: dict[str, Any], frame: int = 0, *, where: str = "FOLD data", validate: bool = True
+    data: dict[str, Any],
+    frame: int = 0,
+    *,
+    where: str = "FOLD data",
+    validate: bool = True,
+    developable: bool | None = None,
 ) -> CreasePattern:
     """Build a CreasePattern from a parsed FOLD dictionary (see :func:`read_fold`)."""
     fr = _frame(data, frame, where)
@@ -231,7 +236,8 @@ def fold_dict_to_pattern(
     else:
         for k in FACE_DERIVED_KEYS:
             meta.pop(k, None)
-    developable = meta.get(DEVELOPABLE_KEY, True)
+    if developable is None:
+        developable = meta.get(DEVELOPABLE_KEY, True)
     if not isinstance(developable, bool):
         raise PatternError(f"{where}: {DEVELOPABLE_KEY} must be true or false")
     try:
@@ -248,7 +254,11 @@ def fold_dict_to_pattern(
 
 
 def read_fold(
-    source: str | Path | Mapping[str, Any], frame: int = 0, *, validate: bool = True
+    source: str | Path | Mapping[str, Any],
+    frame: int = 0,
+    *,
+    validate: bool = True,
+    developable: bool | None = None,
 ) -> CreasePattern:
     """Read a crease pattern (or one frame of it) from a FOLD file.
 
@@ -260,6 +270,8 @@ def read_fold(
         0 for the key frame, ``k`` for ``file_frames[k - 1]`` (with inheritance).
     validate : bool
         Run :func:`barhinge.pattern.validate.check` (set False for bent, non-rigid states).
+    developable : bool, optional
+        Override the file's ``barhinge:developable`` flag (default True).
 
     Returns
     -------
@@ -268,7 +280,9 @@ def read_fold(
         interpret is kept in ``meta``.
     """
     data, where = _load(source)
-    return fold_dict_to_pattern(data, frame, where=where, validate=validate)
+    return fold_dict_to_pattern(
+        data, frame, where=where, validate=validate, developable=developable
+    )
 
 
 def _coords(V: np.ndarray) -> list[list[float]]:
@@ -395,7 +409,8 @@ def write_fold_path(cp: CreasePattern, fold_path: FoldPath, path: str | Path) ->
             "frame_parent": 0,
             "frame_inherit": True,
             "vertices_coords": _coords(X[s, :n]),
-            "edges_foldAngle": [float(a) for a in A[s]],
+            # an angle that was not measured (NaN) is written as null
+            "edges_foldAngle": [float(a) if np.isfinite(a) else None for a in A[s]],
         }
         lf = fold_path.load_factor
         if lf is not None and np.isfinite(lf[s]):
@@ -421,7 +436,7 @@ def read_fold_path(
     X : (n_frames, n_vertices, 3) float
         Vertex coordinates of every extra frame (z = 0 added to 2-D frames).
     fold_angles_deg : (n_frames, n_edges) float
-        Fold angles of every extra frame, degrees.
+        Fold angles of every extra frame, degrees (NaN where the file has null).
     """
     data, where = _load(source)
     cp = fold_dict_to_pattern(data, 0, where=where)
@@ -446,6 +461,6 @@ def read_fold_path(
         ):
             raise PatternError(f"{where}: frame {k} edges_foldAngle must be {cp.n_edges} numbers")
         Xs.append(V)
-        As.append([0.0 if a is None else float(a) for a in ang])
+        As.append([np.nan if a is None else float(a) for a in ang])
     X = np.array(Xs, float).reshape(len(Xs), cp.n_vertices, 3)
     return cp, X, np.array(As, float).reshape(len(As), cp.n_edges)

@@ -320,7 +320,10 @@ def read_svg(
     P = S.reshape(-1, 2).copy()
     P[:, 1] = -P[:, 1]
     P -= P.min(0)
-    size = float(np.linalg.norm(np.ptp(P, axis=0)))
+    with np.errstate(over="ignore"):
+        size = float(np.linalg.norm(np.ptp(P, axis=0)))
+    if not np.isfinite(size):
+        raise PatternError(f"{where}: coordinates too large (bounding box overflows)")
     if size == 0:
         raise PatternError(f"{where}: all crease lines have zero length")
     tol = MERGE_REL * size if merge_tol is None else float(merge_tol)

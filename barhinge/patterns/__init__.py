@@ -27,6 +27,7 @@ from barhinge.patterns.miura import (
     miura_fold_angles,
     miura_geometry,
     miura_layout,
+    miura_layout_of,
 )
 from barhinge.patterns.miura_arc import miura_arc
 from barhinge.patterns.miura_nonuniform import miura_nonuniform
@@ -107,6 +108,7 @@ __all__ = [
     "miura_fold_angles",
     "miura_geometry",
     "miura_layout",
+    "miura_layout_of",
     "miura_nonuniform",
     "miura_tachi",
     "pleats",

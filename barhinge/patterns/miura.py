@@ -40,7 +40,13 @@ import math
 import numpy as np
 
 from barhinge.pattern.crease import CreasePattern
-from barhinge.patterns._common import GridLayout, build_pattern, check_int, check_range
+from barhinge.patterns._common import (
+    GridLayout,
+    build_pattern,
+    check_int,
+    check_range,
+    grid_layout,
+)
 
 __all__ = [
     "MiuraGeometry",
@@ -50,6 +56,7 @@ __all__ = [
     "miura_geometry",
     "miura_grid_coords",
     "miura_layout",
+    "miura_layout_of",
 ]
 
 #: default facet angle theta (deg) whose fold angles become the flat pattern's targets
@@ -181,6 +188,14 @@ def miura_layout(nx: int, ny: int) -> MiuraLayout:
     nx = check_int("nx", nx, 1, family="miura")
     ny = check_int("ny", ny, 1, family="miura")
     return MiuraLayout(2 * nx + 1, 2 * ny + 1)
+
+
+def miura_layout_of(cp: CreasePattern) -> MiuraLayout:
+    """The :class:`MiuraLayout` of a pattern made by :func:`miura` or a grid-based variation
+    (``miura_arc``, ``miura_nonuniform``, ``miura_tachi``, ``russo_pleat``), read from
+    ``cp.meta['barhinge:grid']`` (also after a FOLD round trip)."""
+    g = grid_layout(cp)
+    return MiuraLayout(g.ni, g.nj)
 
 
 def miura_fold_angles(layout: GridLayout, alpha: float, theta: float) -> np.ndarray:

@@ -7,6 +7,7 @@ Nothing here is imported by ``import barhinge``; rendering libraries load on fir
 from __future__ import annotations
 
 import logging
+import os
 from pathlib import Path
 from typing import Any
 
@@ -64,7 +65,7 @@ def fold_outputs_hook(fold_path: Any, scene: Any, out_dir: Path) -> list[Path]:
     state), ``fold_path.fold`` (FOLD frames), ``fold_path_steps.csv``,
     ``fold_path_summary.json`` (final state, stiffness, curvature, strains) and
     ``fold_path.png``, ``fold_path_energy_density.png``, ``fold_path_charts.png``,
-    ``fold_path.gif``.
+    ``fold_path.gif`` (skipped when the environment sets ``BARHINGE_PICTURES=0``).
     """
     from barhinge.io import write_results
 
@@ -74,6 +75,9 @@ def fold_outputs_hook(fold_path: Any, scene: Any, out_dir: Path) -> list[Path]:
     files = write_results(
         fold_path, model, out_dir, name="fold_path", npz=False, fixed=fixed, loads=loads
     )
+    if os.environ.get("BARHINGE_PICTURES", "").strip() == "0":
+        log.info("BARHINGE_PICTURES=0: no pictures")
+        return list(files.values())
     try:
         pics = write_pictures(fold_path, model, out_dir, name="fold_path")
     except Exception as exc:  # noqa: BLE001 - pictures are optional; never lose the results

@@ -23,6 +23,8 @@ __all__ = [
     "summary_figure",
 ]
 
+#: more actuators than this: no per-actuator legend
+MAX_LEGEND = 4
 COLORS = ("#1f5fa6", "#c0392b", "#2e8b57", "#8e44ad", "#d68910", "#566573")
 
 
@@ -65,7 +67,7 @@ def plot_actuator_angles(fold_path: Any, ax=None, path: str | Path | None = None
             ax.plot(steps, tgt, color=c, lw=1, ls="--")
     ax.set_xlabel("step")
     ax.set_ylabel("fold angle (deg, valley > 0)")
-    if len(fold_path.actuator_edges):
+    if 0 < len(fold_path.actuator_edges) <= MAX_LEGEND:
         ax.legend(
             frameon=False,
             fontsize="small",
@@ -85,8 +87,12 @@ def plot_fold_angles(fold_path: Any, ax=None, path: str | Path | None = None):
     for e in moving:
         c = "#1f5fa6" if A[-1, e] > 0 else "#c0392b"
         ax.plot(steps, A[:, e], color=c, lw=0.7, alpha=0.5)
-    for e in fold_path.actuator_edges:
-        ax.plot(steps, A[:, e], color="black", lw=2.0, label=f"actuator {e}")
+    for k, e in enumerate(fold_path.actuator_edges):
+        n_act = len(fold_path.actuator_edges)
+        label = (
+            f"actuator {e}" if n_act <= MAX_LEGEND else (f"{n_act} actuators" if k == 0 else None)
+        )
+        ax.plot(steps, A[:, e], color="black", lw=2.0, label=label)
     ax.axhline(0, color="black", lw=0.6)
     ax.set_xlabel("step")
     ax.set_ylabel("fold angle (deg; valleys blue, mountains red)")
@@ -130,7 +136,7 @@ def plot_actuator_moments(fold_path: Any, ax=None, path: str | Path | None = Non
     ax.axhline(0, color="black", lw=0.8)
     ax.set_xlabel("actuator fold angle (deg)")
     ax.set_ylabel("actuator moment (force x length)")
-    if len(fold_path.actuator_edges):
+    if 0 < len(fold_path.actuator_edges) <= MAX_LEGEND:
         ax.legend(frameon=False, fontsize="small")
     return _finish(ax, path, "Actuator moments")
 
@@ -190,8 +196,10 @@ def summary_figure(fold_path: Any, path: str | Path | None = None):
         panels.append(plot_energy)
     if np.isfinite(np.asarray(fold_path.actuator_moments, float)).any():
         panels.append(plot_actuator_moments)
-    fig, axs = plt.subplots(1, len(panels), figsize=(5 * len(panels), 4.2), layout="constrained")
-    for draw, ax in zip(panels, np.atleast_1d(axs), strict=True):
+    shape = (2, 2) if len(panels) == 4 else (1, len(panels))
+    size = (11.0, 8.0) if len(panels) == 4 else (5.0 * len(panels), 4.2)
+    fig, axs = plt.subplots(*shape, figsize=size, layout="constrained")
+    for draw, ax in zip(panels, np.ravel(axs), strict=True):
         draw(fold_path, ax)
     if path is not None:
         fig.savefig(path, dpi=130, facecolor="white")

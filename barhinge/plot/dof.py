@@ -73,8 +73,16 @@ def draw_dof(
     if ok.any():
         vmax = max(int(val[ok].max()), 1)
         cmap = plt.get_cmap("viridis", vmax + 1)
-        sc = ax.scatter(V[ok, 0], V[ok, 1], c=val[ok], cmap=cmap, vmin=-0.5, vmax=vmax + 0.5,
-                        s=max(4.0, 2000.0 / max(ok.sum(), 1)), zorder=3)  # fmt: skip
+        sc = ax.scatter(
+            V[ok, 0],
+            V[ok, 1],
+            c=val[ok],
+            cmap=cmap,
+            vmin=-0.5,
+            vmax=vmax + 0.5,
+            s=max(4.0, 2000.0 / max(ok.sum(), 1)),
+            zorder=3,
+        )
         cb = fig.colorbar(sc, ax=ax, ticks=range(vmax + 1))
         cb.set_label(f"{which} DOF")
     ax.set_aspect("equal")

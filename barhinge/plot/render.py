@@ -154,15 +154,41 @@ def _clim(name: str, v: np.ndarray | None, clim: Sequence[float] | None) -> tupl
 
 
 # ---------------------------------------------------------------------------- pyvista
-def _polydata(d: StateData):
+def _polydata(d: StateData) -> dict[str, Any]:
+    """PyVista meshes of a state sharing its points: ``panels`` (triangles), ``lines`` (all
+    bars / edges), ``crease`` (kind 2) and ``outline`` (kind 3; None when empty)."""
     import pyvista as pv
 
+    def lines_of(L: np.ndarray):
+        if len(L) == 0:
+            return None
+        return pv.PolyData(d.points.copy(), lines=np.column_stack([np.full(len(L), 2), L]).ravel())
+
+    kind = d.line_data["kind"]
     tri = np.column_stack([np.full(len(d.triangles), 3), d.triangles]).ravel()
-    panels = pv.PolyData(d.points, faces=tri)
-    lines = pv.PolyData(
-        d.points, lines=np.column_stack([np.full(len(d.lines), 2), d.lines]).ravel()
-    )
-    return panels, lines
+    return {
+        "panels": pv.PolyData(d.points.copy(), faces=tri),
+        "lines": lines_of(d.lines),
+        "crease": lines_of(d.lines[kind == 2]),
+        "outline": lines_of(d.lines[kind == 3]),
+    }
+
+
+def _assign(meshes: dict[str, Any], d: StateData, where: str, name: str, values) -> None:
+    """Put the state's coordinates and the coloured array on the meshes (in place)."""
+    for m in meshes.values():
+        if m is not None:
+            m.points = d.points
+    if where == "point":
+        meshes["panels"].point_data[name] = values
+    elif where == "triangle":
+        meshes["panels"].cell_data[name] = values
+    elif where == "line":
+        if name == "fold_angle_deg":
+            if meshes["crease"] is not None:
+                meshes["crease"].cell_data[name] = values[d.line_data["kind"] == 2]
+        else:
+            meshes["lines"].cell_data[name] = values
 
 
 def _plotter(window_size: tuple[int, int]):
@@ -173,16 +199,17 @@ def _plotter(window_size: tuple[int, int]):
     return p
 
 
-def _add_state(
-    p, d: StateData, where: str, name: str, values, cmap, clim, line_width: float, label=None
-):
-    """Add the panels and lines of a state to plotter p; returns (coloured actor, scalar bar
-    arguments) for :func:`_scalar_bar`, or None when nothing is coloured."""
-    panels, lines = _polydata(d)
+def _add_state(p, meshes, where: str, name: str, cmap, clim, line_width: float, label=None):
+    """Add the meshes of :func:`_polydata` (arrays set by :func:`_assign`) to plotter p;
+    returns (coloured actor, scalar bar arguments) for :func:`_scalar_bar`, or None when
+    nothing is coloured."""
+    panels, lines = meshes["panels"], meshes["lines"]
     default_label, default_cmap, _ = ARRAYS.get(name, (name, "viridis", False))
     label = label or default_label
     cmap = cmap or default_cmap
+    fs = max(10, int(round(p.window_size[1] / 45)))
     sbar = {
+        "n_labels": 5 if p.window_size[0] >= 800 else 3,
         "title": label,
         "vertical": False,
         "position_x": 0.25,
@@ -191,21 +218,12 @@ def _add_state(
         "height": 0.08,
         "color": "black",
         "fmt": "%.3g",
-        "title_font_size": 18,
-        "label_font_size": 15,
+        "title_font_size": fs,
+        "label_font_size": max(9, fs - 3),
     }
-    kind = d.line_data["kind"]
-
-    def sub(mask):
-        return lines.extract_cells(np.flatnonzero(mask)) if mask.any() else None
-
-    crease, outline = sub(kind == 2), sub(kind == 3)
+    crease, outline = meshes["crease"], meshes["outline"]
     tube = max(line_width, 1.0)
     if where in ("point", "triangle"):
-        if where == "point":
-            panels.point_data[name] = values
-        else:
-            panels.cell_data[name] = values
         actor = p.add_mesh(
             panels,
             scalars=name,
@@ -224,7 +242,6 @@ def _add_state(
     if where == "line" and name == "fold_angle_deg":
         actor = None
         if crease is not None:
-            crease.cell_data[name] = values[kind == 2]
             actor = p.add_mesh(
                 crease,
                 scalars=name,
@@ -238,7 +255,6 @@ def _add_state(
             p.add_mesh(outline, color="#6e6e6e", line_width=0.8 * tube)
         return (actor, sbar) if actor is not None else None
     if where == "line":
-        lines.cell_data[name] = values
         actor = p.add_mesh(
             lines,
             scalars=name,
@@ -260,12 +276,16 @@ def _scalar_bar(p, bar) -> None:
     if bar is not None:
         actor, sbar = bar
         sb = p.add_scalar_bar(mapper=actor.mapper, **sbar)
-        sb.SetTextPositionToPrecedeScalarBar()  # tick labels under the bar, title above
+        if sb is not None:
+            sb.SetTextPositionToPrecedeScalarBar()  # tick labels under the bar, title above
 
 
-def _fit(p, margin: float = 0.05, bottom: float = 0.16, top: float = 0.0) -> None:
+def _fit(
+    p, margin: float = 0.05, bottom: float = 0.16, top: float = 0.0, shrink_only: bool = False
+) -> None:
     """Zoom and pan so the picture fills the window between a band at the top (title) and
     one at the bottom (colour bar), fractions of the height; one test render without them."""
+    p.render()
     img = np.asarray(p.screenshot(return_img=True), float)
     h, w = img.shape[:2]
     ink = np.argwhere(img.min(axis=2) < 245)
@@ -276,6 +296,9 @@ def _fit(p, margin: float = 0.05, bottom: float = 0.16, top: float = 0.0) -> Non
     free = h * (1 - bottom - top)
     avail_h, avail_w = free * (1 - 2 * margin), w * (1 - 2 * margin)
     scale = min(avail_h / ch, avail_w / cw)
+    free_rows = (h * top, h * (1 - bottom))
+    if shrink_only and scale >= 1 and r0 >= free_rows[0] and r1 <= free_rows[1]:
+        return
     cam = p.camera
     pos, foc = np.asarray(cam.position), np.asarray(cam.focal_point)
     fwd = foc - pos
@@ -427,7 +450,9 @@ def render_state(
         return _render_mpl(d, where, name, values, cmap, lim, path, window_size, view, title, label)
     p = _plotter(window_size)
     try:
-        bar = _add_state(p, d, where, name, values, cmap, lim, line_width=2.0, label=label)
+        meshes = _polydata(d)
+        _assign(meshes, d, where, name, values)
+        bar = _add_state(p, meshes, where, name, cmap, lim, line_width=2.0, label=label)
         _camera(p, _bounds(d.points[None]), view)
         _fit(p, bottom=0.16 if bar is not None else 0.0, top=0.08 if title else 0.0)
         _scalar_bar(p, bar)
@@ -529,14 +554,27 @@ def animate(
                 )
                 frames.append(Image.open(f).convert("RGB"))
     else:
-        for d, (where, nm, v) in zip(datas, picked, strict=True):
-            p = _plotter(window_size)
-            try:
-                _scalar_bar(p, _add_state(p, d, where, nm, v, None, lim, line_width=1.5))
-                _camera(p, bounds, view)
+        # one plotter and one set of actors, updated in place: VTK compiles its shaders
+        # (slow with a software renderer) only for the first frame
+        p = _plotter(window_size)
+        try:
+            meshes = _polydata(datas[0])
+            for k, (d, (where, nm, v)) in enumerate(zip(datas, picked, strict=True)):
+                _assign(meshes, d, where, nm, v)
+                if k == 0:
+                    bar = _add_state(p, meshes, where, nm, None, lim, line_width=1.5)
+                    _camera(p, bounds, view)
+                    # fit the first and the last state, then show the colour bar
+                    bottom = 0.16 if bar is not None else 0.0
+                    _fit(p, bottom=bottom)
+                    _assign(meshes, datas[-1], *picked[-1])
+                    _fit(p, bottom=bottom, shrink_only=True)
+                    _assign(meshes, d, where, nm, v)
+                    _scalar_bar(p, bar)
+                p.render()
                 frames.append(Image.fromarray(p.screenshot(return_img=True)))
-            finally:
-                p.close()
+        finally:
+            p.close()
     if boomerang and len(frames) > 2:
         frames = frames + frames[-2:0:-1]
     pal = [f.convert("P", palette=Image.Palette.ADAPTIVE, colors=255) for f in frames]

@@ -88,8 +88,13 @@ def actuator_terms(model: Any, X: np.ndarray, hinge_ids: np.ndarray) -> Actuator
     na = len(hinge_ids)
     if na == 0:
         z = np.zeros(0)
-        return ActuatorTerms(z, sp.csr_matrix((0, n_dof)), z.reshape(0, 12), z.reshape(0, 12, 12),
-                             np.zeros((0, 12), np.int64))
+        return ActuatorTerms(
+            z,
+            sp.csr_matrix((0, n_dof)),
+            z.reshape(0, 12),
+            z.reshape(0, 12, 12),
+            np.zeros((0, 12), np.int64),
+        )
     rho, grad, hess = hinge_derivatives(model, X, hinge_ids)
     nodes = np.asarray(model.hinges)[hinge_ids]  # (na, 4)
     dofs = (3 * nodes[:, :, None] + np.arange(3)[None, None, :]).reshape(na, 12)
@@ -109,8 +114,9 @@ class BorderedSystem:
     timer : Timer
     """
 
-    def __init__(self, backend: LinearBackend, free: np.ndarray, act_dofs: np.ndarray,
-                 timer: Timer) -> None:
+    def __init__(
+        self, backend: LinearBackend, free: np.ndarray, act_dofs: np.ndarray, timer: Timer
+    ) -> None:
         self.backend = backend
         self.free = np.asarray(free, bool)
         self.free_idx = np.flatnonzero(self.free)
@@ -181,12 +187,12 @@ class BorderedSystem:
         else:
             data = K.data
         nf = len(self.free_idx)
-        return sp.csr_matrix((data[self._sel], self._sub_indices, self._sub_indptr),
-                             shape=(nf, nf))
+        return sp.csr_matrix((data[self._sel], self._sub_indices, self._sub_indptr), shape=(nf, nf))
 
     # ---------------------------------------------------------------- factorise
-    def factorize(self, K: sp.csr_matrix, terms: ActuatorTerms, mu: np.ndarray,
-                  penalty: float) -> None:
+    def factorize(
+        self, K: sp.csr_matrix, terms: ActuatorTerms, mu: np.ndarray, penalty: float
+    ) -> None:
         """Factorise ``A = K_ff + sum mu_a H_a + p G^T G`` and the Schur complement.
 
         Raises SingularMatrixError when A or S is singular.
@@ -219,11 +225,15 @@ class BorderedSystem:
             try:
                 self.S_inv = np.linalg.inv(S)
             except np.linalg.LinAlgError as exc:
-                raise SingularMatrixError("Schur complement G A^-1 G^T is singular: "
-                                          "actuators are redundant or fixed by supports") from exc
+                raise SingularMatrixError(
+                    "Schur complement G A^-1 G^T is singular: "
+                    "actuators are redundant or fixed by supports"
+                ) from exc
             if not np.all(np.isfinite(self.S_inv)) or np.linalg.cond(S) > 1e14:
-                raise SingularMatrixError("Schur complement G A^-1 G^T is singular: "
-                                          "actuators are redundant or fixed by supports")
+                raise SingularMatrixError(
+                    "Schur complement G A^-1 G^T is singular: "
+                    "actuators are redundant or fixed by supports"
+                )
         else:
             self.Gf = None
 
@@ -271,8 +281,9 @@ def gdcm_sign(prev_tangent: np.ndarray | None, tangent: np.ndarray, prev_sign: f
     return prev_sign * (1.0 if float(prev_tangent @ tangent) >= 0 else -1.0)
 
 
-def gdcm_scale(first_tangent: np.ndarray, prev_tangent: np.ndarray | None,
-               tangent: np.ndarray) -> float:
+def gdcm_scale(
+    first_tangent: np.ndarray, prev_tangent: np.ndarray | None, tangent: np.ndarray
+) -> float:
     """|GSP|^(1/2) with the generalized stiffness parameter
     ``GSP = (du_1^1 . du_1^1) / (du_1^{i-1} . du_1^i)`` (Yang & Shieh 1990; Leon et al. 2011,
     Eq. for the GDCM load increment ``dlambda_1^i = +-dlambda_1^1 |GSP|^(1/2)``)."""

@@ -99,7 +99,7 @@ class _Driver:
         self.c_scale = 1.0
         self.n_fact_last = 0
         self._inertia: int | None = None
-        self.system.track_inertia = scene.control == "load"
+        self.system.track_inertia = scene.control in ("load", "displacement")
 
     # ------------------------------------------------------------ schedules
     def targets(self, t: float) -> np.ndarray:
@@ -245,7 +245,8 @@ class _Driver:
         if bad:
             raise _Failed(
                 f"limit point: the tangent's negative eigenvalues went from {self._inertia} to "
-                f"{bad[0]} inside the increment (use control = 'arc_length' to pass it)", res
+                f"{bad[0]} inside the increment (use control = 'arc_length' to pass it)",
+                res,
             )
 
     def _check_jump(self, st: _State, x_pred: np.ndarray, new: _State, res: list[float]) -> None:
@@ -259,12 +260,14 @@ class _Driver:
         if corr > step + self.opts.tol_disp * self.size:
             raise _Failed(
                 f"limit point: Newton left the branch (correction {corr:.3g} > predictor step "
-                f"{step:.3g}; use control = 'arc_length' to pass it)", res
+                f"{step:.3g}; use control = 'arc_length' to pass it)",
+                res,
             )
 
     def _merit(self, e: _Eval) -> float:
-        return float(e.r[self.free] @ e.r[self.free]) + float((self.c_scale * e.c) @ e.c
-                                                              * self.c_scale)
+        return float(e.r[self.free] @ e.r[self.free]) + float(
+            (self.c_scale * e.c) @ e.c * self.c_scale
+        )
 
     def _line_search(self, st: _State, e: _Eval, dx: np.ndarray, dmu: np.ndarray):
         """Backtracking (Armijo) on the merit function; the trial evaluation is reused."""
@@ -275,7 +278,9 @@ class _Driver:
             trial.x[self.free] += alpha * dx
             et = self.evaluate(trial)
             phi = self._merit(et)
-            if (np.isfinite(phi) and phi <= (1 - 1e-4 * alpha) * phi0) or k == self.opts.line_search:
+            if (
+                np.isfinite(phi) and phi <= (1 - 1e-4 * alpha) * phi0
+            ) or k == self.opts.line_search:
                 return trial, et, alpha
             alpha *= 0.5
         raise AssertionError("unreachable")
@@ -366,7 +371,10 @@ class _Driver:
             f"after {self.opts.max_cutbacks} cut-backs ({why})"
         )
         return ConvergenceError(
-            msg, step=step, load_factor=lam, residuals=res,
+            msg,
+            step=step,
+            load_factor=lam,
+            residuals=res,
             last_state=self.path(converged=False, message=msg),
         )
 
@@ -402,8 +410,9 @@ class _Driver:
                 try:
                     new, e_new, res = self.increment(st, t1, t1)
                 except _Failed as f:
-                    log.debug("step %d: increment to t=%.6g failed (%s); cutting back", s, t1,
-                              f.why)
+                    log.debug(
+                        "step %d: increment to t=%.6g failed (%s); cutting back", s, t1, f.why
+                    )
                     h = h_try / 2
                     if h < h_min * (1 - 1e-9):
                         raise self.fail(s, st.lam, f.why, f.residuals) from None
@@ -447,7 +456,6 @@ class _Driver:
         first_tan: np.ndarray | None = None
         prev_tan: np.ndarray | None = None
         sign = 1.0
-        free = self.free
         n = 0
         while st.lam < 1.0 - 1e-12 and n < max_steps:
             n += 1

@@ -87,8 +87,9 @@ class SolverOptions:
         if not (isinstance(self.max_cutbacks, int) and self.max_cutbacks >= 0):
             raise ConfigError(f"solver option max_cutbacks = {self.max_cutbacks!r}; expected >= 0")
         if self.predictor not in ("secant", "tangent"):
-            raise ConfigError(f"solver option predictor = {self.predictor!r}; "
-                              "expected 'secant' or 'tangent'")
+            raise ConfigError(
+                f"solver option predictor = {self.predictor!r}; expected 'secant' or 'tangent'"
+            )
         if not (isinstance(self.line_search, int) and self.line_search >= 0):
             raise ConfigError(f"solver option line_search = {self.line_search!r}; expected >= 0")
         a = self.augmentation

@@ -86,12 +86,33 @@ def write_outputs(path: FoldPath, scene: Any, out_dir: str | Path) -> list[Path]
     with cs.open("w", newline="") as fh:
         w = csv.writer(fh)
         names = [f"actuator_{e}_moment" for e in path.actuator_edges]
-        w.writerow(["state", "load_factor", "iterations", "energy_bars", "energy_bend",
-                    "energy_fold", "external_work", "wall_time", *names])
+        w.writerow(
+            [
+                "state",
+                "load_factor",
+                "iterations",
+                "energy_bars",
+                "energy_bend",
+                "energy_fold",
+                "external_work",
+                "wall_time",
+                *names,
+            ]
+        )
         for i in range(path.n_states):
-            w.writerow([i, path.load_factor[i], path.iterations[i], path.energy_bars[i],
-                        path.energy_bend[i], path.energy_fold[i], path.external_work[i],
-                        path.wall_time[i], *path.actuator_moments[i].tolist()])
+            w.writerow(
+                [
+                    i,
+                    path.load_factor[i],
+                    path.iterations[i],
+                    path.energy_bars[i],
+                    path.energy_bend[i],
+                    path.energy_fold[i],
+                    path.external_work[i],
+                    path.wall_time[i],
+                    *path.actuator_moments[i].tolist(),
+                ]
+            )
     files.append(cs)
     for hook in OUTPUT_HOOKS:
         try:

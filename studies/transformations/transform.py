@@ -19,26 +19,27 @@ def _material():
     return Material(E=1e6, nu=0.3, t=0.01)
 
 
-# name -> (module in barhinge.patterns, generator, keyword arguments quick / full)
-PATTERNS: dict[str, tuple[str, dict, dict]] = {
-    "miura": ("miura", {"nx": 3, "ny": 3}, {"nx": 5, "ny": 5}),
-    "miura_arc": ("miura_arc", {"nx": 3, "ny": 3}, {"nx": 5, "ny": 4}),
+# name -> (module of barhinge.patterns, generator, keyword arguments quick, full)
+PATTERNS: dict[str, tuple[str, str, dict, dict]] = {
+    "miura": ("miura", "miura", {"nx": 3, "ny": 3}, {"nx": 5, "ny": 5}),
+    "miura_arc": ("miura_arc", "miura_arc", {"nx": 3, "ny": 3}, {"nx": 5, "ny": 4}),
     "miura_nonuniform": (
+        "miura_nonuniform",
         "miura_nonuniform",
         {"a": [1.0, 0.6, 1.0, 0.6], "b": [1.0, 0.5, 1.0, 0.5]},
         {"a": [1.0, 0.6, 1.0, 0.6, 1.0, 0.6], "b": [1.0, 1.0, 0.5, 0.5, 1.0, 1.0]},
     ),
-    "russo_pleat": ("russo_pleat", {}, {}),
-    "yoshimura": ("yoshimura", {"nx": 3, "ny": 3}, {"nx": 5, "ny": 4}),
-    "resch": ("resch", {}, {}),
+    "russo_pleat": ("russo", "russo_pleat", {"pleats": 3, "strips": 2}, {}),
+    "yoshimura": ("yoshimura", "yoshimura", {"nx": 3, "ny": 3}, {"nx": 5, "ny": 4}),
+    "resch": ("resch", "resch", {"nx": 4, "ny": 4}, {}),
 }
 
 
 def make_pattern(name: str, quick: bool):
     """The flat crease pattern of a study pattern (quick or full size)."""
-    func, kq, kf = PATTERNS[name]
+    module, func, kq, kf = PATTERNS[name]
     try:
-        gen = getattr(importlib.import_module(f"barhinge.patterns.{func}"), func)
+        gen = getattr(importlib.import_module(f"barhinge.patterns.{module}"), func)
     except (ImportError, AttributeError):
         raise ImportError(f"barhinge.patterns has no generator {func!r} yet") from None
     return gen(**(kq if quick else kf))
@@ -83,7 +84,9 @@ def fold(cp, acts, steps: int):
     from barhinge.kinematics.path import RigidOptions
 
     try:
-        path = bh.rigid_fold(cp, acts, steps=steps, options=RigidOptions(check_actuators=False))
+        # over-determined actuators fail at the first step; 3 cut-backs tell that quickly
+        opts = RigidOptions(check_actuators=False, max_cutbacks=3)
+        path = bh.rigid_fold(cp, acts, steps=steps, options=opts)
         if path.converged:
             return path, None, None
         reason = f"not converged: {path.message}"

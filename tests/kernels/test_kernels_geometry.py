@@ -16,6 +16,7 @@ from barhinge.kernels.geometry import (
     hinge_angle,
     hinge_angle_derivatives,
     hinge_angle_gradient,
+    hinge_angle_gradient_t,
     hinge_angle_hessian_packed,
 )
 from barhinge.kernels.reference import bar_reference, hinge_reference, hinge_with_angle
@@ -92,6 +93,8 @@ def test_vectorised_hinge_equals_liu_paulino_oracle(seed: int) -> None:
         assert rel(Hp[:, e], Ho[TRIU12]) <= 1e-12
         assert rel(gp[:, e], go) <= 1e-12
     assert np.array_equal(r2, rho)
+    r3, g3 = hinge_angle_gradient_t(X, hinges, chunk=3)  # several chunks
+    assert np.array_equal(r3, rho) and rel(g3.T, g) <= 1e-14
 
 
 @pytest.mark.parametrize("measure", ["green", "engineering"])

@@ -19,11 +19,15 @@ def _laws():
     x = np.concatenate([rng.uniform(-3.1, 3.1, 40), [LO - 0.3, HI + 0.3, 3.0, -3.0, 1e-7]])
     x0 = rng.uniform(-1.0, 1.0, len(x))
     k = rng.uniform(0.5, 2.0, len(x))
-    return {
-        "bar": (x * 0.05, lambda e: bar_linear(e, k, 0.7 + 0 * k)),
-        "linear": (x, lambda r: hinge_linear(r, x0, k)),
-        "penetration": (x, lambda r: hinge_penetration(r, x0, k, LO, HI)),
-    }, x0, k
+    return (
+        {
+            "bar": (x * 0.05, lambda e: bar_linear(e, k, 0.7 + 0 * k)),
+            "linear": (x, lambda r: hinge_linear(r, x0, k)),
+            "penetration": (x, lambda r: hinge_penetration(r, x0, k, LO, HI)),
+        },
+        x0,
+        k,
+    )
 
 
 @pytest.mark.parametrize("name", ["bar", "linear", "penetration"])
@@ -82,7 +86,7 @@ def test_hinge_energy_gradient_hessian_match_fd(law_name: str, rho_deg: float) -
     H4 = np.array([[0, 1, 2, 3]])
     r0 = np.array([np.radians(rho_deg) * 0.5 + 0.05])
 
-    def law(r):
+    def law(r, sl=slice(None)):
         if law_name == "linear":
             return hinge_linear(r, r0, np.array([1.3]))
         return hinge_penetration(r, r0, np.array([1.3]), LO, HI)
@@ -103,8 +107,8 @@ def test_hinge_energy_gradient_hessian_match_fd(law_name: str, rho_deg: float) -
         Xp[c // 3, c % 3] += h
         Xm[c // 3, c % 3] -= h
         fd_f[c] = (energy(Xp) - energy(Xm)) / (2 * h)
-        rp, Mp, *_ , gp, _ = hinge_energy_hessian_packed(Xp, H4, law)
-        rm, Mm, *_ , gm, _ = hinge_energy_hessian_packed(Xm, H4, law)
+        rp, Mp, *_, gp, _ = hinge_energy_hessian_packed(Xp, H4, law)
+        rm, Mm, *_, gm, _ = hinge_energy_hessian_packed(Xm, H4, law)
         fd_H[c] = (Mp[0] * gp[:, 0] - Mm[0] * gm[:, 0]) / (2 * h)
     scale_f = np.abs(f).max()
     scale_H = np.abs(H).max()

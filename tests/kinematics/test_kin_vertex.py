@@ -65,8 +65,9 @@ def test_degree4_flat_foldable_vertex_follows_fold_angle_multiplier(
     cp = vertex_pattern(sectors, asg)
     path = bh.rigid_fold(cp, [drive], [target], steps=8)
     assert path.kind == "rigid" and path.converged
-    np.testing.assert_allclose(path.fold_angles_deg[:, drive], np.linspace(0, target, 9),
-                               rtol=0, atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(
+        path.fold_angles_deg[:, drive], np.linspace(0, target, 9), rtol=0, atol=1e-12
+    )
     _check_mode(path, mode, a, b)
 
 
@@ -79,8 +80,9 @@ def test_miura_vertex_multiplier_is_cos_gamma(vertex_pattern):
     path = bh.rigid_fold(cp, [0], [120.0], steps=6)
     rz = np.radians(path.fold_angles_deg[:, 0])
     rs = np.radians(path.fold_angles_deg[:, 1])
-    np.testing.assert_allclose(np.abs(np.tan(rs / 2)), np.cos(np.radians(g)) * np.tan(rz / 2),
-                               rtol=0, atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(
+        np.abs(np.tan(rs / 2)), np.cos(np.radians(g)) * np.tan(rz / 2), rtol=0, atol=1e-12
+    )
 
 
 @pytest.mark.parametrize("degree", [4, 6, 8])
@@ -114,3 +116,18 @@ def test_nonflatfoldable_vertex_locks_with_a_clear_error(vertex_pattern):
     assert part is not None and not part.converged and part.n_states >= 2
     assert part.fold_angles_deg[-1, 0] > 150.0
     assert np.abs(part.fold_angles_deg).max() < 180.0
+
+
+def test_path_through_the_flat_state_records_the_rank_change(vertex_pattern):
+    """Folding a degree-4 vertex from +60 deg through flat to -60 deg: the flat state is a
+    bifurcation point (DOF 2 to first order, 1 elsewhere); the path records the change and
+    continues on the mirrored branch of the same mode (fold angles flip sign)."""
+    cp = vertex_pattern([70.0, 50.0, 110.0, 130.0], ["V", "M", "V", "V"])
+    up = bh.rigid_fold(cp, [0], [60.0], steps=3)
+    folded = cp.replaced(vertices=up.X[-1], fold_angles=up.fold_angles_deg[-1])
+    path = bh.rigid_fold(folded, [0], [-60.0], steps=4)
+    assert path.meta["dof"] == [1, 1, 2, 1, 1]
+    assert any("DOF changed from 1 to 2" in ev for ev in path.meta["events"])
+    np.testing.assert_allclose(
+        path.fold_angles_deg[-1, :4], -up.fold_angles_deg[-1, :4], rtol=0, atol=1e-9
+    )

@@ -141,7 +141,9 @@ def test_zero_eigenvalues_degree4_vertex(scheme: str) -> None:
     """
     for fold, expect in ((30.0, 7), (None, 8)):
         cp = bh.patterns.miura(1, 1, fold=fold)
-        nz, gap = n_zero_eigenvalues(BarHingeModel.from_pattern(cp, scheme, MAT, fold_stiffness=0.0))
+        nz, gap = n_zero_eigenvalues(
+            BarHingeModel.from_pattern(cp, scheme, MAT, fold_stiffness=0.0)
+        )
         assert nz == expect and gap > 1e-7
         nz, gap = n_zero_eigenvalues(BarHingeModel.from_pattern(cp, scheme, MAT))
         assert nz == 6 and gap > 1e-7
@@ -159,6 +161,10 @@ def test_evaluate_split_and_moments() -> None:
     assert ev.energy_bars == pytest.approx(0.5 * np.sum(m.bar_EA * m.bar_L0 * eps**2))
     assert np.allclose(ev.hinge_moment, m.hinge_k * d)
     assert np.allclose(m.hinge_angles(X), ev.hinge_angle)
+    Wb, Wh = m.element_energies(X)
+    assert Wb.sum() == pytest.approx(ev.energy_bars) and Wh[~fold].sum() == pytest.approx(
+        ev.energy_bend
+    )
     # flattened coordinates are accepted
     assert m.energy(X.ravel()) == pytest.approx(ev.energy)
 
@@ -169,3 +175,14 @@ def test_assembly_scatter_pattern_is_reused() -> None:
     K2 = m.tangent(perturbed(m, 2))
     assert np.shares_memory(K1.indices, K2.indices) and np.shares_memory(K1.indptr, K2.indptr)
     assert K1.data is not K2.data
+
+
+def test_with_and_stiffened_share_the_scatter_maps_and_scale_the_tangent() -> None:
+    m = MODELS[1]
+    X = perturbed(m, 3)
+    K = m.tangent(X)
+    m2 = m.with_(hinge_k=2.0 * m.hinge_k, bar_EA=2.0 * m.bar_EA)
+    assert m2.assembler is m.assembler
+    assert np.allclose(m2.tangent(X).toarray(), 2.0 * K.toarray(), rtol=1e-13, atol=0)
+    with pytest.raises(bh.ConfigError):
+        m.with_(hinge_k=np.ones(3))

@@ -176,9 +176,7 @@ def test_edge_load_errors_against_p2_membrane(
     """Edge loads on W x 1 rectangles (nu = 0.3) vs the P2 membrane (refine 3): the values
     quoted in the table; tolerance 0.005 covers the reference's mesh error (< 0.2 %)."""
     mat = Material(E=1.0, nu=0.3, t=0.01)
-    assert rectangle_edge_load_error(W, 1.0, mat, mode, scheme, cal) == pytest.approx(
-        err, abs=5e-3
-    )
+    assert rectangle_edge_load_error(W, 1.0, mat, mode, scheme, cal) == pytest.approx(err, abs=5e-3)
 
 
 # ----------------------------------------------------------------------- bending hinges
@@ -214,3 +212,51 @@ def test_plate_bending_exact_for_any_quad_and_close_for_hexagon(scheme: str) -> 
         assert abs(e["warp"]) < 1e-8
     e = panel_errors(regular(6), mat, scheme, "fit", "plate", plate_refine=3)
     assert abs(e["warp"]) < 0.04
+
+
+def test_elongated_panels_are_poor_in_every_calibration() -> None:
+    """Finding 2 of docs/calibration.md: a 4:1 rectangle's shear energy is 76-100 % too low
+    and its extension up to 56 % too high, whatever the bar calibration or scheme."""
+    shear, ext = [], []
+    for nu in (0.0, 0.3, 0.45):
+        mat = Material(E=1.0, nu=nu, t=0.01)
+        for scheme in ("N4B5", "N5B8"):
+            for cal in ("filipov", "fit"):
+                e = panel_errors(rect(4, 1), mat, scheme, cal, plate_refine=2)
+                shear.append(e["shear"])
+                ext += [e["uniaxial_x"], e["uniaxial_y"]]
+    assert max(shear) == pytest.approx(-0.758, abs=6e-4)
+    assert min(shear) == pytest.approx(-0.997, abs=6e-4)
+    assert max(ext) == pytest.approx(0.558, abs=6e-4)
+
+
+def test_edge_load_error_ranges() -> None:
+    """Finding 3: over W/H in {1, 2, 4}, both schemes and both calibrations (nu = 0.3),
+    stretch errors lie in [+7 %, +20 %] and shear errors in [-97 %, +44 %]."""
+    mat = Material(E=1.0, nu=0.3, t=0.01)
+    res = {
+        mode: [
+            rectangle_edge_load_error(W, 1.0, mat, mode, s, c)
+            for W in (1.0, 2.0, 4.0)
+            for s in ("N4B5", "N5B8")
+            for c in ("filipov", "fit")
+        ]
+        for mode in ("stretch", "shear")
+    }
+    assert min(res["stretch"]) == pytest.approx(0.070, abs=5e-3)
+    assert max(res["stretch"]) == pytest.approx(0.201, abs=5e-3)
+    assert min(res["shear"]) == pytest.approx(-0.972, abs=5e-3)
+    assert max(res["shear"]) == pytest.approx(0.442, abs=5e-3)
+
+
+def test_filipov_warp_error_range_at_l_over_t_100() -> None:
+    """Finding 4: F17 bending is 2.5 to 15.8 times as stiff as the Kirchhoff plate (error
+    +1.457 ... +14.816) in corner warping over the table's quads and nu at t = 0.01."""
+    errs = []
+    for nu in (0.0, 0.3, 0.45):
+        mat = Material(E=1.0, nu=nu, t=0.01)
+        for P in (rect(1, 1), rect(2, 1), rect(4, 1), parallelogram(1, 1, 60)):
+            for scheme in ("N4B5", "N5B8"):
+                errs.append(panel_errors(P, mat, scheme, "fit", "filipov", plate_refine=2)["warp"])
+    assert min(errs) == pytest.approx(1.457, abs=6e-4)
+    assert max(errs) == pytest.approx(14.816, abs=6e-4)

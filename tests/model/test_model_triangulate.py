@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import barhinge as bh
-from barhinge.errors import ConfigError
+from barhinge.errors import ConfigError, PatternError
 from barhinge.kernels.geometry import hinge_angle
 from barhinge.model.calibrate import Material, bend_stiffness
 from barhinge.model.model import BarHingeModel
@@ -110,10 +112,10 @@ def test_stiffness_defaults_overrides_and_ratio() -> None:
     m3 = BarHingeModel.from_pattern(cp, "N5B8", mat, bar_EA=5.0, bend_k=2.0, fold_k=0.1)
     assert (m3.bar_EA == 5.0).all() and (m3.hinge_k[bend] == 2.0).all()
     assert (m3.hinge_k[fold] == 0.1).all()
-    m4 = BarHingeModel.from_pattern(
-        cp, "N5B8", mat, crease_length_scale=0.05, stiffness_ratio=10.0
+    m4 = BarHingeModel.from_pattern(cp, "N5B8", mat, crease_length_scale=0.05, stiffness_ratio=10.0)
+    assert np.allclose(m4.bar_EA, 10 * m.bar_EA) and np.allclose(
+        m4.hinge_k[bend], 10 * m.hinge_k[bend]
     )
-    assert np.allclose(m4.bar_EA, 10 * m.bar_EA) and np.allclose(m4.hinge_k[bend], 10 * m.hinge_k[bend])
     assert np.allclose(m4.hinge_k[fold], m.hinge_k[fold])
     m5 = m.stiffened(10.0)
     assert np.allclose(m5.bar_EA, m4.bar_EA) and np.allclose(m5.hinge_k, m4.hinge_k)
@@ -146,3 +148,35 @@ def test_bad_material_and_coordinates() -> None:
     m = BarHingeModel.from_pattern(bh.patterns.miura(1, 1))
     with pytest.raises(ConfigError):
         m.evaluate(np.zeros((3, 3)))
+
+
+def test_degenerate_face_raises_pattern_error() -> None:
+    V = np.array([[0, 0], [1, 0], [2, 0]], float)  # a triangle face with collinear corners
+    cp = CreasePattern(V, [[0, 1], [1, 2], [2, 0]], ["B"] * 3, faces=[[0, 1, 2]], validate=False)
+    with pytest.raises(PatternError, match="degenerate"):
+        BarHingeModel.from_pattern(cp, "N5B8")
+
+
+@settings(max_examples=20, deadline=None)
+@given(
+    k=st.integers(3, 8), seed=st.integers(0, 2**31 - 1), scheme=st.sampled_from(["N4B5", "N5B8"])
+)
+def test_random_convex_panel_is_stress_free_and_has_only_rigid_modes(
+    k: int, seed: int, scheme: str
+) -> None:
+    """Any convex polygon, any scheme: zero energy and force at X0, and exactly six zero
+    eigenvalues of the free tangent (3 in-plane + 3 out-of-plane rigid motions): the centre
+    fan (or the N4B5 diagonal) leaves no in-plane or out-of-plane mechanism."""
+    rng = np.random.default_rng(seed)
+    t = np.sort(rng.uniform(0, 2 * np.pi, k))
+    t = t + np.linspace(0, 0.4, k)  # keep corners apart
+    r = rng.uniform(0.8, 1.2)
+    V = np.column_stack(
+        [r * np.cos(t * 2 * np.pi / (t[-1] + 0.4)), r * np.sin(t * 2 * np.pi / (t[-1] + 0.4))]
+    )
+    cp = CreasePattern(V, [[i, (i + 1) % k] for i in range(k)], ["B"] * k, faces=[list(range(k))])
+    m = BarHingeModel.from_pattern(cp, scheme, Material(E=1.0, nu=0.3, t=0.05))
+    ev = m.evaluate(m.X0)
+    assert ev.energy < 1e-25 and np.abs(ev.force).max() < 1e-13
+    w = np.linalg.eigvalsh(ev.K.toarray())
+    assert int((np.abs(w) < 1e-9 * w.max()).sum()) == 6

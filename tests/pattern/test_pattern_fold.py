@@ -111,6 +111,7 @@ def test_fold_path_round_trip(tmp_path: Path) -> None:
     n_states = 4
     X = np.repeat(cp.vertices3d[None], n_states, axis=0) + 0.01 * rng.random((n_states, 4, 3))
     A = rng.uniform(-30, 30, (n_states, cp.n_edges))
+    A[1, 0] = np.nan  # an angle not measured: written as null, read back as NaN
     path = FoldPath(X=X, fold_angles_deg=A, kind="rigid")
     out = write_fold_path(cp, path, tmp_path / "path.fold")
     data = json.loads(out.read_text())
@@ -124,6 +125,7 @@ def test_fold_path_round_trip(tmp_path: Path) -> None:
     s2 = read_fold(out, frame=3, validate=False)
     np.testing.assert_allclose(s2.vertices, X[2], rtol=0, atol=ATOL)
     np.testing.assert_allclose(s2.fold_angles, A[2], rtol=0, atol=ATOL)
+    assert data["file_frames"][1]["edges_foldAngle"][0] is None
 
 
 @pytest.mark.parametrize(

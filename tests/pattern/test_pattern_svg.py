@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from barhinge.errors import PatternError
 from barhinge.pattern.planar import signed_areas
@@ -168,3 +170,43 @@ def test_bad_files(tmp_path: Path) -> None:
         read_svg(bad)
     with pytest.raises(PatternError, match="merge_tol"):
         read_svg(svg(tmp_path, BORDER), merge_tol=-1.0)
+
+
+num = st.one_of(
+    st.integers(-5, 105).map(str),
+    st.floats(-5, 105).map(lambda x: f"{x:.3f}"),
+    st.sampled_from(["nan", "inf", "1e400", "", "abc", "-0"]),
+)
+colour = st.sampled_from(["#f00", "#00f", "#000", "#0f0", "red", "rgb(1,2,3)", "none", "#zzz"])
+opacity = st.sampled_from(["0.5", "1", "0", "2", "-1", "50%", "x", ""])
+
+
+@st.composite
+def shapes(draw) -> str:
+    kind = draw(st.sampled_from(["line", "polyline", "path", "rect", "junk"]))
+    c, o = draw(colour), draw(opacity)
+    xs = draw(st.lists(num, min_size=4, max_size=8))
+    if kind == "line":
+        xy = f'x1="{xs[0]}" y1="{xs[1]}" x2="{xs[2]}" y2="{xs[3]}"'
+        return f'<line {xy} stroke="{c}" opacity="{o}"/>'
+    if kind == "polyline":
+        pts = " ".join(f"{a},{b}" for a, b in zip(xs[::2], xs[1::2], strict=False))
+        return f'<polyline points="{pts}" stroke="{c}" stroke-opacity="{o}" fill="none"/>'
+    if kind == "path":
+        d = f"M{xs[0]},{xs[1]} L{xs[2]},{xs[3]} Q{xs[0]},{xs[3]} {xs[1]},{xs[2]}"
+        return f'<path d="{d}" stroke="{c}"/>'
+    if kind == "rect":
+        return f'<rect x="{xs[0]}" y="{xs[1]}" width="{xs[2]}" height="{xs[3]}" stroke="{c}"/>'
+    return draw(st.text(max_size=20))
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(body=st.lists(shapes(), max_size=6), border=st.booleans())
+def test_fuzz_svg(tmp_path_factory, body: list[str], border: bool) -> None:
+    """Any drawing gives a pattern or a PatternError, never another exception."""
+    p = tmp_path_factory.mktemp("svg") / "f.svg"
+    p.write_text(f"{HEAD}{BORDER if border else ''}{''.join(body)}</svg>")
+    try:
+        read_svg(p)
+    except PatternError:
+        pass

@@ -292,3 +292,13 @@ def test_validator_fuzz_planar_graphs(pts, data) -> None:
     except PatternError:
         return
     assert codes(cp, "error") == set()
+
+
+def test_reflex_corner_angles() -> None:
+    # L-shaped hexagon: the corner at vertex 3 is reflex (270 deg); interior angles of a
+    # simple k-gon sum to (k - 2) * 180 deg
+    V = np.array([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]], float)
+    cp = CreasePattern(V, [[i, (i + 1) % 6] for i in range(6)], ["B"] * 6)
+    ang = np.degrees(cp.face_corner_angles[0])
+    np.testing.assert_allclose(ang, [90, 90, 90, 270, 90, 90], rtol=0, atol=1e-12)
+    assert ang.sum() == pytest.approx((6 - 2) * 180, abs=1e-9)

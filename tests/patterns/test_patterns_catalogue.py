@@ -136,3 +136,32 @@ def test_cli_bad_input_exits_2_with_one_line(monkeypatch, capsys, args, needle):
     assert code == 2
     assert needle in err
     assert len(err.strip().splitlines()) == 1
+
+
+# ------------------------------------------------- CreasePattern.edge_faces (vectorised)
+def _edge_faces_loop(cp) -> np.ndarray:
+    """Slow reference: walk every face side (the original per-face loop)."""
+    EF = -np.ones((cp.n_edges, 2), dtype=np.int64)
+    idx = {(min(a, b), max(a, b)): e for e, (a, b) in enumerate(cp.edges.tolist())}
+    for fi, f in enumerate(cp.faces):
+        for a, b in zip(f, f[1:] + f[:1], strict=True):
+            e = idx[(min(a, b), max(a, b))]
+            EF[e, 0 if cp.edges[e, 0] == a else 1] = fi
+    return EF
+
+
+@pytest.mark.parametrize("stem", ["miura_4x4_a60", "resch_6x6", "os_huffmanWaterbomb", "hypar_5"])
+def test_edge_faces_matches_reference_loop(stem):
+    cp = bh.read_fold(DATA / f"{stem}.fold")
+    assert np.array_equal(cp.edge_faces, _edge_faces_loop(cp))
+
+
+def test_edge_faces_errors():
+    V = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float)
+    E = np.array([[0, 1], [1, 2], [2, 3], [3, 0]])
+    twice = bh.CreasePattern(V, E, ["B"] * 4, faces=[[0, 1, 2, 3]] * 2, validate=False)
+    with pytest.raises(bh.PatternError, match="same direction by faces 0 and 1"):
+        _ = twice.edge_faces
+    missing = bh.CreasePattern(V, E, ["B"] * 4, faces=[[0, 1, 2]], validate=False)
+    with pytest.raises(bh.PatternError, match=r"face 0 uses side \(2, 0\)"):
+        _ = missing.edge_faces

@@ -12,8 +12,9 @@ import math
 import numpy as np
 import pytest
 
+import barhinge as bh
 from barhinge.errors import PatternError
-from barhinge.patterns import miura, miura_geometry, miura_layout
+from barhinge.patterns import miura, miura_geometry, miura_layout, miura_layout_of
 from barhinge.patterns.properties import kawasaki_error, maekawa_count, sector_sum_error
 
 CASES = [(1.0, 1.0, 60.0, 30.0), (1.3, 0.7, 45.0, 70.0), (0.5, 2.0, 75.0, 10.0)]
@@ -148,9 +149,12 @@ def test_faces_counter_clockwise_and_planar():
         assert abs(np.dot(P[2] - P[0], n)) < 1e-12
 
 
-def test_layout_groups():
+def test_layout_groups(tmp_path):
     lay = miura_layout(2, 1)
     cp = miura(2, 1)
+    # the layout can be recovered from the pattern, also after a FOLD round trip
+    path = bh.write_fold(cp, tmp_path / "m.fold")
+    assert miura_layout_of(bh.read_fold(path)) == lay
     X = cp.vertices
     assert np.all(X[lay.left, 0] <= X[:, 0].min() + 1.0)
     assert np.allclose(X[lay.bottom, 1], 0.0)

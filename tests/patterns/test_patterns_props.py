@@ -112,7 +112,7 @@ def test_square_twist_valid(nx, ny, twist, frac):
     _check_flat(square_twist(nx, ny, pitch=2.0, a=a, twist=twist), True)
 
 
-@SETTINGS
+@settings(max_examples=10, deadline=None)
 @given(st.integers(1, 4), st.integers(1, 4), length)
 def test_grid_families_valid(nx, ny, s):
     _check_flat(waterbomb(nx, ny, s=s), True)

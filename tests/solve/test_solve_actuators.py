@@ -16,8 +16,7 @@ def _single_fold(k: float = 0.3, rest_deg: float = 0.0) -> BarHingeModel:
     V = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     E = np.array([[0, 1], [1, 2], [2, 3], [3, 0], [0, 2]])
     cp = bh.CreasePattern(V, E, ["B", "B", "B", "B", "V"])
-    return BarHingeModel.from_pattern(cp, "N4B5", Material(E=1e5, nu=0.3, t=0.01),
-                                      fold_stiffness=k)
+    return BarHingeModel.from_pattern(cp, "N4B5", Material(E=1e5, nu=0.3, t=0.01), fold_stiffness=k)
 
 
 def test_single_fold_actuator_moment_equals_spring_moment():
@@ -70,8 +69,9 @@ def test_equilibrium_at_every_step_with_supports_loads_and_actuators():
     S[3, 2] = True  # corner 3 held vertically: the two triangles are held, the crease folds
     P = np.zeros((n, 3))
     P[2, 2] = -0.01
-    scene = Scene(model, supports=S, loads=P,
-                  actuators=bh.Actuators(edges=[4], targets_deg=[30.0]), steps=4)
+    scene = Scene(
+        model, supports=S, loads=P, actuators=bh.Actuators(edges=[4], targets_deg=[30.0]), steps=4
+    )
     path = bh.solve(scene)
     for i in range(path.n_states):
         F = path.load_factor[i] * P + path.reactions[i]
@@ -84,8 +84,12 @@ def test_equilibrium_at_every_step_with_supports_loads_and_actuators():
 def test_convergence_error_carries_partial_path():
     model = _single_fold(k=0.3)
     # an impossible schedule step: 170 deg in one step with one Newton iteration allowed
-    scene = Scene(model, actuators=bh.Actuators(edges=[4], targets_deg=[170.0]), steps=2,
-                  options={"max_iter": 1, "max_cutbacks": 0})
+    scene = Scene(
+        model,
+        actuators=bh.Actuators(edges=[4], targets_deg=[170.0]),
+        steps=2,
+        options={"max_iter": 1, "max_cutbacks": 0},
+    )
     with pytest.raises(bh.ConvergenceError) as info:
         bh.solve(scene)
     err = info.value

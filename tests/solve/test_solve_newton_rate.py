@@ -3,8 +3,9 @@
 The rate ``p`` is the slope of ``log r_{k+1}`` against ``log r_k`` (r_{k+1} = C r_k^p) fitted
 over the asymptotic tail of one increment's residual sequence: its last three residuals above
 the round-off floor (1e-10 here; the floor is ~1e-12). Earlier iterations are outside the
-quadratic basin (the soft fold modes make it small) and are not part of the rate. Stiffness values are moderate (bars 100, panels 1,
-folds 0.05) so that several iterations fall inside the quadratic basin.
+quadratic basin (the soft fold modes make it small) and are not part of the rate. Stiffness
+values are moderate (bars 100, panels 1, folds 0.05) so that several iterations fall inside
+the quadratic basin.
 """
 
 from __future__ import annotations

@@ -55,7 +55,10 @@ def errors() -> dict[str, np.ndarray]:
     out: dict[str, list[float]] = {"angle": [], "L": [], "S": [], "nu": []}
     for r in RATIOS:
         model = BarHingeModel.from_pattern(
-            cp0, "N5B8", Material(E=1e6, nu=0.3, t=0.01), fold_stiffness=1e-2,
+            cp0,
+            "N5B8",
+            Material(E=1e6, nu=0.3, t=0.01),
+            fold_stiffness=1e-2,
             stiffness_ratio=float(r),
         )
         acts = bh.Actuators(edges=edges, targets_deg=np.asarray(cp1.fold_angles)[edges])

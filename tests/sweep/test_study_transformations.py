@@ -66,5 +66,6 @@ def test_curved_control_of_miura_needs_straining_and_gives_a_saddle(study) -> No
     assert r["actuator_error_deg"] < 1e-6
     assert r["nonsync_deg"] > 1.0
     assert r["K"] < 0 and r["k1"] > 0 > r["k2"]
-    grid = study.RESULTS["miura"]["nonsync_deg"]
-    assert np.all(grid[:, study.KAPPA_L.index(1.0)] > grid[:, study.KAPPA_L.index(0.0)])
+    for p in ("miura", "miura_nonuniform"):  # curvature de-synchronises the local folding
+        grid = study.RESULTS[p]["nonsync_deg"]
+        assert np.all(grid[:, study.KAPPA_L.index(1.0)] > grid[:, study.KAPPA_L.index(0.0)] + 1)

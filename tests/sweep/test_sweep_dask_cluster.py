@@ -100,8 +100,8 @@ def test_worker_killed_mid_sweep_each_point_once(
     tmp_path: Path, cluster: tuple[str, list[subprocess.Popen]]
 ) -> None:
     address, workers = cluster
-    xs = list(range(8))
-    path = write_study(tmp_path, xs, delay=0.6)
+    xs = list(range(6))
+    path = write_study(tmp_path, xs, delay=1.0)  # the kill lands well inside a point
     out = tmp_path / "out"
     victim = workers[0]
     cmd = [sys.executable, "-m", "barhinge.cli", "study", str(path), "--scheduler", address]

@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 
 from barhinge.cli import app
 from barhinge.errors import ConfigError
-from barhinge.sweep import Study, load_study, point_id, read_records, run_study
+from barhinge.sweep import Study, load_study, point_id, read_records, run_study, write_summary
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from sweep_helpers import assert_each_point_once, markers_of, summary_rows, write_study  # noqa: E402
@@ -102,7 +102,7 @@ def test_keyboard_interrupt_then_resume_through_cli(tmp_path: Path) -> None:
 def test_killed_sweep_process_resumes(tmp_path: Path) -> None:
     """SIGKILL the process running a serial sweep after >= 3 points, then resume."""
     xs = list(range(8))
-    path = write_study(tmp_path, xs, delay=0.25)
+    path = write_study(tmp_path, xs, delay=0.4)
     out = tmp_path / "out"
     cmd = [sys.executable, "-m", "barhinge.cli", "study", str(path), "--serial"]
     proc = subprocess.Popen(
@@ -152,3 +152,15 @@ def test_unreachable_scheduler_is_a_config_error(tmp_path: Path) -> None:
     study = load_study(write_study(tmp_path, [1]))
     with pytest.raises(ConfigError, match="cannot connect to the Dask scheduler"):
         run_study(study, scheduler=f"tcp://127.0.0.1:{port}", connect_timeout_s=1.0)
+
+
+def test_summary_keeps_long_results_in_the_records_only(tmp_path: Path) -> None:
+    pts = Study(function="m:f", grid={"a": [1, 2]}).expand()
+    recs = {
+        p.id: {"id": p.id, "params": p.params, "status": "ok", "error": None,
+               "result": {"a": "clash", "big": list(range(500)), "small": [1, 2]}}
+        for p in pts
+    }  # fmt: skip
+    rows = {int(r["a"]): r for r in summary_rows(write_summary(tmp_path, pts, recs).parent)}
+    assert rows[1]["big"] == "(see points/<id>.json)" and json.loads(rows[1]["small"]) == [1, 2]
+    assert rows[2]["result.a"] == "clash"  # a result key clashing with a parameter is renamed

@@ -1,0 +1,773 @@
+"""Reference cases: closed forms from the literature, recomputed with barhinge.
+
+Each :class:`Case` names its source, computes one or more quantities with the library
+(rigid kinematics, the bar-and-hinge solver, the analyses) and compares every quantity with
+its published closed form. ``barhinge verify`` runs them and prints the table; the tests run
+it too. A case must take a few seconds at most (the whole suite runs in CI).
+
+Error measure: ``|computed - reference| / |reference|`` (the absolute error when the reference
+is 0); a quantity passes when that error is at most its tolerance. Every tolerance carries a
+comment saying where the remaining error comes from (round-off of an exact computation, a
+solver tolerance, a discretisation, a finite stiffness ratio).
+
+Adding a case: write a function returning ``{quantity: computed}`` and register a
+:class:`Case` with one :class:`Quantity` per key in :data:`CASES`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+import time
+from collections.abc import Callable, Iterable, Sequence
+
+import numpy as np
+
+__all__ = ["CASES", "Case", "Check", "Quantity", "run", "summary"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclasses.dataclass(frozen=True)
+class Quantity:
+    """One published value.
+
+    Attributes
+    ----------
+    name : str
+        Key in the dict returned by the case's ``compute``.
+    reference : float
+        The closed-form value.
+    tolerance : float
+        Largest accepted relative error (absolute when ``reference == 0``).
+    why : str
+        Why the tolerance is what it is.
+    formula : str
+        The closed form, as printed in the source.
+    """
+
+    name: str
+    reference: float
+    tolerance: float
+    why: str
+    formula: str = ""
+
+
+@dataclasses.dataclass(frozen=True)
+class Case:
+    """A reference case: a computation with barhinge and the published values it must match.
+
+    Attributes
+    ----------
+    name : str
+    citation : str
+        Author(s), year, journal, equation.
+    description : str
+        What is computed and how (model, control, parameters).
+    compute : callable () -> dict[str, float]
+    quantities : tuple of Quantity
+    quick : bool
+        Part of ``barhinge verify --quick``.
+    """
+
+    name: str
+    citation: str
+    description: str
+    compute: Callable[[], dict[str, float]]
+    quantities: tuple[Quantity, ...]
+    quick: bool = True
+
+
+@dataclasses.dataclass(frozen=True)
+class Check:
+    """One row of the verification table."""
+
+    case: str
+    quantity: str
+    citation: str
+    reference: float
+    computed: float
+    error: float
+    tolerance: float
+    time_s: float
+    passed: bool
+    why: str = ""
+    message: str = ""
+
+    def as_dict(self) -> dict[str, object]:
+        return dataclasses.asdict(self)
+
+
+def _error(computed: float, reference: float) -> float:
+    if not math.isfinite(computed):
+        return math.inf
+    if reference == 0.0:
+        return abs(computed)
+    return abs(computed - reference) / abs(reference)
+
+
+def run_case(case: Case) -> list[Check]:
+    """Run one case; an exception fails every quantity of the case with its message."""
+    t0 = time.perf_counter()
+    message = ""
+    try:
+        values = case.compute()
+    except Exception as exc:  # noqa: BLE001 - a failing case is a result, not a crash
+        values = {}
+        message = f"{type(exc).__name__}: {exc}"
+        log.warning("verify case %s raised %s", case.name, message)
+    dt = time.perf_counter() - t0
+    rows = []
+    for q in case.quantities:
+        c = float(values.get(q.name, math.nan))
+        err = _error(c, q.reference)
+        msg = message or ("" if q.name in values else f"case returned no {q.name!r}")
+        rows.append(
+            Check(
+                case=case.name,
+                quantity=q.name,
+                citation=case.citation,
+                reference=float(q.reference),
+                computed=c,
+                error=err,
+                tolerance=q.tolerance,
+                time_s=dt,
+                passed=bool(err <= q.tolerance) and not msg,
+                why=q.why,
+                message=msg,
+            )
+        )
+    return rows
+
+
+def run(
+    cases: Iterable[Case] | None = None,
+    *,
+    names: Sequence[str] | None = None,
+    quick: bool = False,
+    on_case: Callable[[Case, list[Check]], None] | None = None,
+) -> list[Check]:
+    """Run reference cases and return one :class:`Check` per quantity.
+
+    Parameters
+    ----------
+    cases : iterable of Case, optional
+        Default: every registered case (:data:`CASES`).
+    names : sequence of str, optional
+        Only these cases (by name); unknown names raise ConfigError.
+    quick : bool
+        Only the cases marked ``quick``.
+    on_case : callable, optional
+        Called after each case with its rows (progress display).
+    """
+    from barhinge.errors import ConfigError
+
+    pool = list(CASES.values()) if cases is None else list(cases)
+    if names:
+        known = {c.name: c for c in pool}
+        bad = [n for n in names if n not in known]
+        if bad:
+            raise ConfigError(
+                f"unknown verify case {bad[0]!r}; expected one of {', '.join(sorted(known))}"
+            )
+        pool = [known[n] for n in names]
+    elif quick:
+        pool = [c for c in pool if c.quick]
+    out: list[Check] = []
+    for case in pool:
+        rows = run_case(case)
+        out.extend(rows)
+        if on_case is not None:
+            on_case(case, rows)
+    return out
+
+
+def summary(checks: Sequence[Check]) -> dict[str, object]:
+    """Counts for a list of checks (JSON-serialisable)."""
+    return {
+        "n_checks": len(checks),
+        "n_cases": len({c.case for c in checks}),
+        "n_passed": sum(c.passed for c in checks),
+        "n_failed": sum(not c.passed for c in checks),
+        "passed": all(c.passed for c in checks),
+        "time_s": sum({c.case: c.time_s for c in checks}.values()),
+    }
+
+
+# =============================================================================== helpers
+def _material():
+    from barhinge.model.calibrate import Material
+
+    return Material(E=1.0e6, nu=0.3, t=0.01)
+
+
+def _sg_closed_forms(a: float, b: float, gamma_deg: float, theta_deg: float) -> dict[str, float]:
+    """Schenk & Guest (2013) PNAS 110(9):3276, Eq. 1-2, written out here (independently of
+    ``barhinge.patterns.miura_geometry``): cell height H, half width S, half length L,
+    zig-zag offset V, straight-crease fold angle and in-plane Poisson's ratio nu_SL."""
+    g, th = math.radians(gamma_deg), math.radians(theta_deg)
+    xi = math.sqrt(1.0 + math.cos(th) ** 2 * math.tan(g) ** 2)
+    return {
+        "H": a * math.sin(th) * math.sin(g),
+        "S": b * math.cos(th) * math.tan(g) / xi,
+        "L": a * math.sqrt(1.0 - math.sin(th) ** 2 * math.sin(g) ** 2),
+        "V": b / xi,
+        "rho_straight_deg": math.degrees(2.0 * math.atan(math.cos(g) * math.tan(th))),
+        "nu_SL": -(math.cos(th) ** 2) * math.tan(g) ** 2,
+    }
+
+
+def _miura_dims(X: np.ndarray, ni: int) -> dict[str, float]:
+    """Frame-independent H, S, L, V of the Miura cell at the corner of a grid-numbered sheet
+    (vertex (i, j) has id j * ni + i; see barhinge.patterns.miura)."""
+
+    def v(i: int, j: int) -> np.ndarray:
+        return X[j * ni + i]
+
+    eL = v(2, 0) - v(0, 0)
+    eS = v(0, 2) - v(0, 0)
+    L = float(np.linalg.norm(eL)) / 2
+    S = float(np.linalg.norm(eS)) / 2
+    eL, eS = eL / (2 * L), eS / (2 * S)
+    n = np.cross(eL, eS)
+    n /= np.linalg.norm(n)
+    return {
+        "H": abs(float((v(1, 0) - v(0, 0)) @ n)),
+        "S": S,
+        "L": L,
+        "V": abs(float((v(0, 1) - v(0, 0)) @ eL)),
+    }
+
+
+# =============================================================================== cases
+# Miura-ori cell used by the Miura cases: a = 1, b = 1.5, gamma = 60 deg, theta = 50 deg.
+_MA, _MB, _MG, _MT = 1.0, 1.5, 60.0, 50.0
+_SG = _sg_closed_forms(_MA, _MB, _MG, _MT)
+_SG_CITE = "Schenk & Guest 2013, PNAS 110(9):3276, Eq. 1-2"
+
+
+def _miura_rigid() -> dict[str, float]:
+    """Rigid path of one flat Miura cell, driven by its first interior zig-zag crease to
+    -2 theta (the zig-zag fold angle of S&G's theta), then theta +- 0.05 deg for nu_SL."""
+    import barhinge as bh
+    from barhinge.patterns.miura import miura_layout
+
+    cp = bh.patterns.miura(1, 1, a=_MA, b=_MB, alpha=_MG)
+    lay = miura_layout(1, 1)
+    ez = int(lay.interior_zigzag_edges[0])
+    es = int(lay.interior_straight_edges[0])
+    sign = math.copysign(1.0, float(cp.fold_angles[ez]))
+    d = 0.05
+    tab = np.r_[np.linspace(10.0, 2 * (_MT - d), 5), 2 * _MT, 2 * (_MT + d)]
+    path = bh.rigid_fold(cp, bh.Actuators(edges=[ez], table_deg=sign * tab[:, None]), steps=len(tab))
+    out = _miura_dims(path.X[-2], lay.ni)
+    out["rho_straight_deg"] = abs(float(path.fold_angles_deg[-2, es]))
+    lo, hi = _miura_dims(path.X[-3], lay.ni), _miura_dims(path.X[-1], lay.ni)
+    # central difference of ln L against ln S (error O(d^2) ~ 1e-6)
+    out["nu_SL"] = -math.log(hi["L"] / lo["L"]) / math.log(hi["S"] / lo["S"])
+    return out
+
+
+_EXACT = "rigid path closes the loop equations to 1e-13: round-off only"
+
+_miura_rigid_case = Case(
+    name="miura_rigid",
+    citation=_SG_CITE,
+    description=(
+        "Rigid folding path (bh.rigid_fold) of a flat 1x1 Miura cell (a=1, b=1.5, "
+        "gamma=60 deg) to theta=50 deg; cell dimensions measured frame-free from the vertices"
+    ),
+    compute=_miura_rigid,
+    quantities=(
+        Quantity("H", _SG["H"], 1e-9, _EXACT, "H = a sin(theta) sin(gamma)"),
+        Quantity(
+            "S", _SG["S"], 1e-9, _EXACT,
+            "S = b cos(theta) tan(gamma) / sqrt(1 + cos^2(theta) tan^2(gamma))",
+        ),
+        Quantity("L", _SG["L"], 1e-9, _EXACT, "L = a sqrt(1 - sin^2(theta) sin^2(gamma))"),
+        Quantity("V", _SG["V"], 1e-9, _EXACT, "V = b / sqrt(1 + cos^2(theta) tan^2(gamma))"),
+        Quantity(
+            "rho_straight_deg", _SG["rho_straight_deg"], 1e-9, _EXACT,
+            "tan(rho_s/2) = cos(gamma) tan(theta)",
+        ),
+        Quantity(
+            "nu_SL", _SG["nu_SL"], 1e-5,
+            "central difference over theta +- 0.05 deg: truncation O(d^2) ~ 2e-6",
+            "nu_SL = -cos^2(theta) tan^2(gamma)",
+        ),
+    ),
+)  # fmt: skip
+
+
+def _miura_barhinge() -> dict[str, float]:
+    """Bar-and-hinge (N5B8) model of the same cell, bars and bending stiffened 1000x relative
+    to the folds, folded by fold-angle control of the same zig-zag crease."""
+    import barhinge as bh
+    from barhinge.patterns.miura import miura_layout
+
+    cp = bh.patterns.miura(1, 1, a=_MA, b=_MB, alpha=_MG)
+    lay = miura_layout(1, 1)
+    ez = int(lay.interior_zigzag_edges[0])
+    sign = math.copysign(1.0, float(cp.fold_angles[ez]))
+    model = bh.BarHingeModel.from_pattern(
+        cp, scheme="N5B8", material=_material(), stiffness_ratio=1e3
+    )
+    scene = bh.Scene(
+        model, actuators=bh.Actuators(edges=[ez], targets_deg=[sign * 2 * _MT]), steps=8
+    )
+    path = bh.solve(scene)
+    return _miura_dims(path.X[-1], lay.ni)
+
+
+_RL = "finite stiffness ratio 1e3: panels strain by O(k_fold/k_panel); measured 4e-4"
+_miura_bh_case = Case(
+    name="miura_barhinge_rigid_limit",
+    citation=_SG_CITE,
+    description=(
+        "bh.solve, fold-angle control, N5B8 Miura cell with stiffness_ratio=1e3 (rigid-panel "
+        "limit of Filipov et al. 2017), folded to theta=50 deg"
+    ),
+    compute=_miura_barhinge,
+    quantities=(
+        Quantity("H", _SG["H"], 2e-3, _RL, "H = a sin(theta) sin(gamma)"),
+        Quantity("S", _SG["S"], 2e-3, _RL, "S = b cos(theta) tan(gamma) / xi"),
+        Quantity("L", _SG["L"], 2e-3, _RL, "L = a sqrt(1 - sin^2(theta) sin^2(gamma))"),
+    ),
+    quick=False,
+)
+
+# generic flat-foldable degree-4 vertex: sector angles alpha, beta, pi - alpha, pi - beta
+_D4A, _D4B = 70.0, 50.0
+
+
+def _degree4_pattern(fold_angles=None):
+    from barhinge.pattern.crease import CreasePattern
+
+    a, b = math.radians(_D4A), math.radians(_D4B)
+    dirs = [0.0, a, a + b, math.pi + b]
+    V = [[0.0, 0.0]] + [[math.cos(d), math.sin(d)] for d in dirs]
+    E = [[0, 1], [0, 2], [0, 3], [0, 4], [1, 2], [2, 3], [3, 4], [4, 1]]
+    asg = list("MVMM" if fold_angles is None else "MMVM") + list("BBBB")
+    F = None if fold_angles is None else list(fold_angles) + [0.0] * 4
+    return CreasePattern(
+        vertices=V, edges=E, assignment=asg, fold_angles=F,
+        faces=[[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]],
+    )  # fmt: skip
+
+
+_RHO1 = -40.0  # degrees, crease 1 (direction 0, between sectors pi - beta and alpha)
+
+
+def _degree4() -> dict[str, float]:
+    """Rigid path of a single degree-4 vertex driven by crease 1 to -40 deg, once on each of
+    its two folding modes (mode 2 chosen by target fold angles: explicit branch choice)."""
+    import barhinge as bh
+
+    out = {}
+    p1 = bh.rigid_fold(_degree4_pattern(), [0], targets_deg=[_RHO1], steps=6)
+    r = np.radians(p1.fold_angles_deg[-1, :4])
+    out["mode1_multiplier"] = math.tan(r[1] / 2) / math.tan(r[0] / 2)
+    q = _mult2()
+    r2 = math.degrees(2 * math.atan(q * math.tan(math.radians(-20.0) / 2)))
+    cp2 = _degree4_pattern([-20.0, r2, 20.0, r2])  # branch direction, not the result
+    p2 = bh.rigid_fold(cp2, [0], targets_deg=[_RHO1], steps=6)
+    r = np.radians(p2.fold_angles_deg[-1, :4])
+    out["mode2_multiplier"] = math.tan(r[1] / 2) / math.tan(r[0] / 2)
+    return out
+
+
+def _mult1() -> float:
+    a, b = math.radians(_D4A), math.radians(_D4B)
+    return -math.cos((a + b) / 2) / math.cos((a - b) / 2)
+
+
+def _mult2() -> float:
+    a, b = math.radians(_D4A), math.radians(_D4B)
+    return math.sin((a + b) / 2) / math.sin((a - b) / 2)
+
+
+_degree4_case = Case(
+    name="degree4_vertex",
+    citation=(
+        "Huffman 1976 IEEE Trans. Computers C-25(10); Evans, Lang, Magleby & Howell 2015 "
+        "R. Soc. Open Sci. 2:150067; Tachi & Hull 2017 J. Mech. Robot. 9(2):021008"
+    ),
+    description=(
+        "Flat-foldable degree-4 vertex, sectors 70/50/110/130 deg, rigid path to rho1=-40 deg; "
+        "fold-angle multiplier tan(rho2/2)/tan(rho1/2) on both branches"
+    ),
+    compute=_degree4,
+    quantities=(
+        Quantity(
+            "mode1_multiplier", _mult1(), 1e-9, _EXACT,
+            "tan(rho2/2) = -cos((a+b)/2)/cos((a-b)/2) tan(rho1/2)  (rho1 = rho3)",
+        ),
+        Quantity(
+            "mode2_multiplier", _mult2(), 1e-9, _EXACT,
+            "tan(rho2/2) = sin((a+b)/2)/sin((a-b)/2) tan(rho1/2)  (rho1 = -rho3)",
+        ),
+    ),
+)  # fmt: skip
+
+
+def _maekawa_kawasaki() -> dict[str, float]:
+    """|#M - #V| and the alternate sector-angle sum at every interior vertex of flat
+    Miura (gamma = 60 deg) and Yoshimura sheets; the worst vertex is reported."""
+    import barhinge as bh
+    from barhinge.patterns.properties import maekawa_count
+
+    m, kw = [], []
+    for cp in (bh.patterns.miura(2, 2, alpha=_MG), bh.patterns.yoshimura(4, 2)):
+        m.extend(np.abs(maekawa_count(cp)[cp.interior_vertices]).tolist())
+        for v in cp.interior_vertices:
+            sec = np.asarray(cp.sector_angles[v])
+            kw.append(float(sec[0::2].sum()))
+    m_arr, kw_arr = np.asarray(m, float), np.asarray(kw)
+    return {
+        "max_abs_M_minus_V": float(m_arr.max()),
+        "min_abs_M_minus_V": float(m_arr.min()),
+        "alternate_sector_sum": float(kw_arr[np.argmax(np.abs(kw_arr - math.pi))]),
+    }
+
+
+_maekawa_case = Case(
+    name="maekawa_kawasaki",
+    citation=(
+        "Maekawa (Justin 1986); Kawasaki 1989; Demaine & O'Rourke 2007, Geometric Folding "
+        "Algorithms, Thm 12.2.2 and 12.2.4"
+    ),
+    description="Vertex conditions of the flat Miura (2x2) and Yoshimura (4x2) generators",
+    compute=_maekawa_kawasaki,
+    quantities=(
+        Quantity("max_abs_M_minus_V", 2.0, 0.0, "integer count: exact", "|M - V| = 2"),
+        Quantity("min_abs_M_minus_V", 2.0, 0.0, "integer count: exact", "|M - V| = 2"),
+        Quantity(
+            "alternate_sector_sum", math.pi, 1e-12, "sum of angles from coordinates: round-off",
+            "a1 + a3 + ... = pi",
+        ),
+    ),
+)  # fmt: skip
+
+
+def _icosahedron() -> tuple[np.ndarray, np.ndarray]:
+    p = (1 + 5**0.5) / 2
+    X = np.array(
+        [[-1, p, 0], [1, p, 0], [-1, -p, 0], [1, -p, 0], [0, -1, p], [0, 1, p],
+         [0, -1, -p], [0, 1, -p], [p, 0, -1], [p, 0, 1], [-p, 0, -1], [-p, 0, 1]], float,
+    )  # fmt: skip
+    from scipy.spatial import ConvexHull
+
+    return X, ConvexHull(X).simplices
+
+
+def _curvature() -> dict[str, float]:
+    """Angle defects of a closed polyhedron; global-form curvature of sphere and saddle
+    samples (bh.gaussian_curvature, local quadratic fits)."""
+    import barhinge as bh
+    from barhinge.analysis.curvature import angle_defect
+
+    X, T = _icosahedron()
+    X = X * (1.0 + 0.05 * np.sin(np.arange(len(X))))[:, None]  # not regular: any polyhedron
+    out = {"descartes_sum": float(np.nansum(angle_defect(X, T)))}
+    R = 2.0
+    g = np.linspace(-0.4, 0.4, 9)
+    x, y = (a.ravel() for a in np.meshgrid(g, g))
+    centre = int(np.argmin(x * x + y * y))
+    sphere = np.column_stack([x, y, R - np.sqrt(R * R - x * x - y * y)])
+    out["K_sphere"] = float(bh.gaussian_curvature(sphere).K[centre])
+    saddle = np.column_stack([x, y, (x * x - y * y) / (2 * R)])
+    out["K_saddle"] = float(bh.gaussian_curvature(saddle).K[centre])
+    return out
+
+
+_curv_tol = "local quadratic fit over radius ~0.25 R of a sphere: O((r/R)^2) bias"
+_curvature_case = Case(
+    name="curvature",
+    citation="Descartes (angle defect theorem); Gauss 1827 (K = 1/R^2 of a sphere, -1/R^2 "
+    "at the saddle z=(x^2-y^2)/2R); Meyer et al. 2003",
+    description=(
+        "Angle-defect sum of a perturbed icosahedron; K at the centre of 9x9 samples of a "
+        "sphere (R=2) and a saddle"
+    ),
+    compute=_curvature,
+    quantities=(
+        Quantity("descartes_sum", 4 * math.pi, 1e-12, "exact theorem: round-off", "sum = 4 pi"),
+        Quantity("K_sphere", 0.25, 2e-2, _curv_tol, "K = 1/R^2"),
+        Quantity("K_saddle", -0.25, 2e-2, _curv_tol, "K = -1/R^2"),
+    ),
+)
+
+
+def _dof() -> dict[str, float]:
+    import barhinge as bh
+
+    cp = bh.patterns.miura(3, 3, alpha=_MG)
+    rep = bh.dof(cp)
+    fold = rep.folded if rep.folded is not None else rep
+    n_e = int(np.isin(cp.assignment, ["M", "V"]).sum())
+    n_v = len(cp.interior_vertices)
+    return {
+        "counted_dof": float(rep.counted_dof),
+        "counted_dof_formula_check": float(n_e - 3 * n_v),
+        "dof_folded": float(fold.global_dof),
+    }
+
+
+_dof_case = Case(
+    name="dof_miura",
+    citation="Tachi 2010, 'Geometric considerations for the design of rigid origami "
+    "structures', IASS (DOF = E_in - 3 V_in); Schenk & Guest 2013 (Miura: one DOF)",
+    description="bh.dof of a 3x3 Miura sheet: counted DOF and the rank DOF at a folded state",
+    compute=_dof,
+    quantities=(
+        # 3x3 Miura: E_in = 5*6 + 5*6 = 60... counted by hand: rows 5 x 6 + columns 5 x 6
+        Quantity(
+            "counted_dof", 60 - 3 * 25, 0.0, "integer count: exact",
+            "E_in - 3 V_in with E_in = 2(2nx-1)(2ny) = 60, V_in = (2nx-1)(2ny-1) = 25",
+        ),
+        Quantity("dof_folded", 1.0, 0.0, "rank of the loop-closure Jacobian: exact", "1"),
+    ),
+)  # fmt: skip
+
+
+_K_FOLD = 2.0  # moment per radian per unit crease length
+_RHO_ACT = 90.0
+
+
+def _fold_moment() -> dict[str, float]:
+    """Two square panels joined by one crease of length 1, folded to 90 deg by fold-angle
+    control: the actuator moment equals the hinge's linear law."""
+    import barhinge as bh
+    from barhinge.pattern.crease import CreasePattern
+
+    V = [[-1, 0], [0, 0], [1, 0], [1, 1], [0, 1], [-1, 1]]
+    E = [[0, 1], [1, 2], [2, 3], [3, 4], [4, 5], [5, 0], [1, 4]]
+    cp = CreasePattern(
+        vertices=V, edges=E, assignment=list("BBBBBBV"), faces=[[0, 1, 4, 5], [1, 2, 3, 4]]
+    )
+    model = bh.BarHingeModel.from_pattern(
+        cp, scheme="N4B5", material=_material(), fold_stiffness=_K_FOLD
+    )
+    path = bh.solve(
+        bh.Scene(model, actuators=bh.Actuators(edges=[6], targets_deg=[_RHO_ACT]), steps=4)
+    )
+    return {"actuator_moment": float(path.actuator_moments[-1, 0])}
+
+
+_fold_case = Case(
+    name="fold_actuator_moment",
+    citation="Liu & Paulino 2017, Proc. R. Soc. A 473:20170348 (linear hinge "
+    "M = k L (rho - rho0)); Filipov et al. 2017 IJSS 124:26",
+    description="Two 1x1 panels, one crease (L=1, k=2), bh.solve fold-angle control to 90 deg",
+    compute=_fold_moment,
+    quantities=(
+        Quantity(
+            "actuator_moment", _K_FOLD * 1.0 * math.radians(_RHO_ACT), 1e-6,
+            "panels unstressed by a single fold; Newton tolerance 1e-8",
+            "M = k L (rho - rho0)",
+        ),
+    ),
+)  # fmt: skip
+
+_SW, _SH, _SN = 1.0, 1.2, 4  # strip of 4 panels 1 x 1.2 (x by y)
+
+
+def _membrane_strip() -> dict[str, float]:
+    """Strip of 4 rectangular N5B8 panels (F17 bars), left edge held in x (one node also
+    in y), all nodes held in z, pulled at the right edge by a tiny load; axial stiffness."""
+    import barhinge as bh
+    from barhinge.pattern.crease import CreasePattern
+
+    n = _SN
+    V = [[i * _SW, j * _SH] for j in (0, 1) for i in range(n + 1)]
+    faces = [[i, i + 1, n + 2 + i, n + 1 + i] for i in range(n)]
+    edges = [[i, i + 1] for i in range(n)] + [[n + 1 + i, n + 2 + i] for i in range(n)]
+    edges += [[i, n + 1 + i] for i in range(n + 1)]
+    asg = ["B"] * (2 * n) + ["B"] + ["F"] * (n - 1) + ["B"]
+    cp = CreasePattern(vertices=V, edges=edges, assignment=asg, faces=faces)
+    mat = _material()
+    model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=mat, bar_calibration="filipov")
+    nn = model.n_nodes
+    S = np.zeros((nn, 3), bool)
+    S[:, 2] = True
+    left, right = [0, n + 1], [n, 2 * n + 1]
+    S[left, 0] = True
+    S[0, 1] = True
+    P = np.zeros((nn, 3))
+    F = 1e-6 * mat.E * mat.t * _SH  # strain 1e-6: geometric nonlinearity ~1e-6
+    P[right, 0] = F / 2
+    path = bh.solve(bh.Scene(model, supports=S, loads=P, control="load", steps=1))
+    u = float(path.X[-1, right, 0].mean() - model.X0[right, 0].mean())
+    return {"axial_stiffness": F / u}
+
+
+_strip_case = Case(
+    name="membrane_strip",
+    citation="Filipov et al. 2017 IJSS 124:26 (N5B8 bar areas, exact in extension); "
+    "uniaxial plane stress k = E t W / L",
+    description="4-panel strip 4 x 1.2, N5B8 with F17 bar areas, end load at strain 1e-6",
+    compute=_membrane_strip,
+    quantities=(
+        Quantity(
+            "axial_stiffness", 1.0e6 * 0.01 * _SH / (_SN * _SW), 1e-4,
+            "Green-strain nonlinearity at strain 1e-6 and Newton tolerance",
+            "k = E t W / L",
+        ),
+    ),
+)  # fmt: skip
+
+
+def _filipov_areas() -> dict[str, float]:
+    import barhinge as bh
+    from barhinge.pattern.crease import CreasePattern
+
+    W, H = 1.0, 1.2
+    cp = CreasePattern(
+        vertices=[[0, 0], [W, 0], [W, H], [0, H]],
+        edges=[[0, 1], [1, 2], [2, 3], [3, 0]],
+        assignment=list("BBBB"),
+        faces=[[0, 1, 2, 3]],
+    )
+    mat = _material()
+    m = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=mat, bar_calibration="filipov")
+    A = np.asarray(m.bar_EA) / mat.E
+    L = np.asarray(m.bar_L0)
+    pick = lambda length: float(A[np.argmin(np.abs(L - length))])  # noqa: E731
+    return {"A_W": pick(W), "A_H": pick(H), "A_X": pick(math.hypot(W, H) / 2)}
+
+
+def _f17(W: float = 1.0, H: float = 1.2, t: float = 0.01, nu: float = 0.3) -> dict[str, float]:
+    return {
+        "A_W": t * (H**2 - nu * W**2) / (2 * H * (1 - nu**2)),
+        "A_H": t * (W**2 - nu * H**2) / (2 * W * (1 - nu**2)),
+        "A_X": nu * t * (W**2 + H**2) ** 1.5 / (2 * W * H * (1 - nu**2)),
+    }
+
+
+_F17 = _f17()
+_LSQ = "areas from a bounded least-squares fit: solver tolerance"
+_filipov_case = Case(
+    name="filipov_bar_areas",
+    citation="Filipov, Liu, Tachi, Schenk & Paulino 2017, IJSS 124:26-45 (N5B8 bar areas)",
+    description="Bar areas of one 1 x 1.2 N5B8 panel (bar_calibration='filipov', nu=0.3)",
+    compute=_filipov_areas,
+    quantities=(
+        Quantity("A_W", _F17["A_W"], 1e-8, _LSQ, "A_W = t (H^2 - nu W^2) / (2 H (1 - nu^2))"),
+        Quantity("A_H", _F17["A_H"], 1e-8, _LSQ, "A_H = t (W^2 - nu H^2) / (2 W (1 - nu^2))"),
+        Quantity(
+            "A_X", _F17["A_X"], 1e-8, _LSQ, "A_X = nu t (W^2 + H^2)^1.5 / (2 W H (1 - nu^2))"
+        ),
+    ),
+)
+
+# von Mises two-bar truss: half span a, rise h, EA
+_VMA, _VMH, _VMEA = 1.0, 0.3, 1000.0
+
+
+def von_mises_model(a: float = _VMA, h: float = _VMH, EA: float = _VMEA, spring: float = 0.0):
+    """Bar model of the von Mises truss (x-z plane): supports 0, 1 at (-+a, 0, 0), apex 2 at
+    (0, 0, h). With ``spring > 0`` a node 3 at (0, 0, 2 h) hangs above the apex on a bar of
+    axial stiffness ``spring`` (EA / length) for displacement control through the spring.
+
+    Returns (model, supports (n, 3) bool, apex node id).
+    """
+    import barhinge as bh
+    from barhinge.pattern.crease import CreasePattern
+
+    if spring <= 0:
+        cp = CreasePattern(
+            vertices=[[-a, 0, 0], [a, 0, 0], [0, 0, h]],
+            edges=[[0, 1], [1, 2], [2, 0]],
+            assignment=list("BBB"),
+            faces=[[0, 1, 2]],
+        )
+        model = bh.BarHingeModel.from_pattern(cp, scheme="N4B5", bar_EA=EA)
+    else:
+        cp = CreasePattern(
+            vertices=[[-a, 0, 0], [a, 0, 0], [0, 0, h], [0, 0, 2 * h]],
+            edges=[[0, 1], [1, 2], [2, 0], [2, 3], [3, 0]],
+            assignment=list("BBFBB"),
+            faces=[[0, 1, 2], [0, 2, 3]],
+        )
+        m0 = bh.BarHingeModel.from_pattern(cp, scheme="N4B5", bar_EA=EA, fold_stiffness=0.0)
+        bars = np.sort(np.asarray(m0.bars), axis=1).tolist()
+        EAs = np.full(len(bars), EA)
+        EAs[bars.index([2, 3])] = spring * h
+        EAs[bars.index([0, 3])] = 1e-9 * EA  # a face needs it; carries nothing
+        model = m0.with_(bar_EA=EAs)
+    S = np.zeros((model.n_nodes, 3), bool)
+    S[[0, 1]] = True
+    S[2:, :2] = True
+    return model, S, 2
+
+
+def von_mises_limit_load(a: float = _VMA, h: float = _VMH, EA: float = _VMEA) -> float:
+    """Limit load of the von Mises truss with Green-strain bars (exact for any rise):
+    ``P_max = 2 EA h^3 / (3 sqrt(3) L0^3)``, ``L0 = sqrt(a^2 + h^2)``, at apex height
+    ``h / sqrt(3)``."""
+    return 2 * EA * h**3 / (3 * math.sqrt(3) * math.hypot(a, h) ** 3)
+
+
+def _von_mises() -> dict[str, float]:
+    """Arc length (MGDCM) through the snap-through of the von Mises truss; the first peak of
+    the load factor refined by a parabola through the three states around it."""
+    import barhinge as bh
+
+    model, S, apex = von_mises_model()
+    Pmax = von_mises_limit_load()
+    P = np.zeros((model.n_nodes, 3))
+    P[apex, 2] = -1.5 * Pmax
+    scene = bh.Scene(
+        model, supports=S, loads=P, control="arc_length", steps=20,
+        options={"max_arc_steps": 200},
+    )  # fmt: skip
+    path = bh.solve(scene)
+    lam = path.load_factor
+    k = int(np.argmax(np.diff(lam) < 0))
+    z = path.X[:, apex, 2]
+    c = np.polyfit(z[k - 1 : k + 2], lam[k - 1 : k + 2], 2)
+    zs = -c[1] / (2 * c[0])
+    return {"limit_load": float(np.polyval(c, zs)) * 1.5 * Pmax, "apex_height_at_limit": zs}
+
+
+_vm_case = Case(
+    name="von_mises_truss",
+    citation="Krenk 2009, Non-linear Modeling and Analysis of Solids and Structures, ch. 1 "
+    "(two-bar truss, Green strain); Leon, Paulino et al. 2011, Appl. Mech. Rev. 64:040803",
+    description=(
+        "Two Green-strain bars (half span 1, rise 0.3, EA=1000), arc-length control (MGDCM) "
+        "to 1.5 x the limit load; peak from a parabola through 3 states"
+    ),
+    compute=_von_mises,
+    quantities=(
+        Quantity(
+            "limit_load", von_mises_limit_load(), 1e-3,
+            "peak between arc-length states, parabola fit: measured 1e-5",
+            "P_max = 2 EA h^3 / (3 sqrt(3) L0^3)",
+        ),
+        Quantity(
+            "apex_height_at_limit", _VMH / math.sqrt(3), 1e-2,
+            "location of a flat maximum from a parabola: O(step)",
+            "z = h / sqrt(3)",
+        ),
+    ),
+    quick=False,
+)  # fmt: skip
+
+#: every registered case, by name
+CASES: dict[str, Case] = {
+    c.name: c
+    for c in (
+        _miura_rigid_case,
+        _miura_bh_case,
+        _degree4_case,
+        _maekawa_case,
+        _curvature_case,
+        _dof_case,
+        _fold_case,
+        _strip_case,
+        _filipov_case,
+        _vm_case,
+    )
+}

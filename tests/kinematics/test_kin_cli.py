@@ -1,0 +1,51 @@
+"""`barhinge dof` command and the local-DOF picture."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+from typer.testing import CliRunner
+
+import barhinge as bh
+from barhinge.cli import app
+
+
+def test_dof_command_json_and_png(tmp_path):
+    png = tmp_path / "dof.png"
+    res = CliRunner().invoke(app, ["dof", "miura:nx=2,ny=2", "--json", "--png", str(png)])
+    assert res.exit_code == 0, res.output
+    data = json.loads(res.output)
+    direct = bh.dof(bh.patterns.miura(2, 2))
+    assert data["state"]["global_dof"] == direct.global_dof
+    assert data["state"]["counted_dof"] == direct.counted_dof
+    assert data["folded_state"]["global_dof"] == 1
+    assert data["folded_state"]["redundant"] == 1 - direct.counted_dof
+    assert data["folded_state"]["actuators"] == direct.folded.actuators.tolist()
+    assert png.stat().st_size > 5000
+    with open(png, "rb") as fh:
+        assert fh.read(8) == b"\x89PNG\r\n\x1a\n"
+
+
+def test_dof_command_table_and_bad_pattern():
+    res = CliRunner().invoke(app, ["dof", "miura:nx=2,ny=2", "--triangulated"])
+    assert res.exit_code == 0, res.output
+    assert "counted DOF" in res.output and "redundant" in res.output
+    bad = CliRunner().invoke(app, ["dof", "no_such_family:n=2"])
+    assert bad.exit_code != 0
+
+
+def test_draw_dof_returns_figure_with_actuators_marked():
+    from barhinge.plot.dof import draw_dof
+
+    cp = bh.patterns.miura(2, 2)
+    rep = bh.dof(cp)
+    fig = draw_dof(cp, rep, which="local")
+    ax = fig.axes[0]
+    # three line collections (creases, boundary, actuators) and one scatter of vertices
+    assert len(ax.collections) == 4
+    offsets = ax.collections[-1].get_offsets()
+    assert len(offsets) == int(np.sum(rep.folded.local >= 0))
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)

@@ -1,0 +1,64 @@
+"""``barhinge fold --form-only``: a scene driven by actuators alone is folded by rigid
+kinematics (the model it needs, docs/speed-accuracy.md); loads need the compliant model.
+
+Reference: the Miura-ori has one rigid DOF and its fold angles at facet angle theta are
+rho_zigzag = 2 theta and tan(rho_straight / 2) = cos(gamma) tan(theta) (Schenk & Guest 2013,
+PNAS 110(9):3276), as given by ``bh.patterns.miura(fold=theta).fold_angles``.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+from typer.testing import CliRunner
+
+import barhinge as bh
+from barhinge.cli import app, form_only_model
+from barhinge.results import FoldPath
+from barhinge.scene import load_scene, miura_line_creases
+
+SCENES = Path(__file__).resolve().parents[2] / "data" / "scenes"
+
+
+def _scene_toml(tmp_path: Path) -> Path:
+    edges = miura_line_creases(bh.patterns.miura(3, 3))
+    targets = np.asarray(bh.patterns.miura(3, 3, fold=40.0).fold_angles)[edges]
+    text = f"""name = "miura-3x3"
+[pattern]
+family = "miura"
+params = {{ nx = 3, ny = 3, fold = 10.0 }}
+[model]
+scheme = "N5B8"
+material = {{ E = 1.0e6, nu = 0.3, t = 0.01 }}
+[actuators]
+edges = {edges.tolist()}
+targets_deg = {targets.tolist()}
+[solve]
+steps = 6
+"""
+    f = tmp_path / "scene.toml"
+    f.write_text(text)
+    return f
+
+
+def test_form_only_folds_actuated_scene_rigidly_to_the_closed_form(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    res = CliRunner().invoke(
+        app, ["fold", str(_scene_toml(tmp_path)), "--form-only", "--json", "--out", str(out)]
+    )
+    assert res.exit_code == 0, res.output
+    info = json.loads(res.stdout)
+    assert info["model"] == "rigid" and info["n_states"] == 7
+    path = FoldPath.load(out / "fold_path.npz")
+    assert path.kind == "rigid"
+    ref = np.asarray(bh.patterns.miura(3, 3, fold=40.0).fold_angles)
+    np.testing.assert_allclose(path.fold_angles_deg[-1], ref, rtol=0, atol=1e-8)
+    assert (out / "fold_path.fold").is_file()
+
+
+def test_form_only_keeps_the_compliant_model_for_loaded_scenes() -> None:
+    scene = load_scene(SCENES / "yoshimura_roof.toml")
+    assert form_only_model(scene)[0] == "bar-hinge"
+    assert form_only_model(load_scene(SCENES / "miura_actuated.toml"))[0] == "rigid"
