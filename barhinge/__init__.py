@@ -23,6 +23,9 @@ _LAZY = {
     "write_fold": "barhinge.pattern.fold",
     "read_svg": "barhinge.pattern.svg",
     "patterns": "barhinge.patterns",
+    "kinematics": "barhinge.kinematics",
+    "analysis": "barhinge.analysis",
+    "sweep": "barhinge.sweep",
     "dof": "barhinge.kinematics.dof",
     "rigid_fold": "barhinge.kinematics.path",
     "BarHingeModel": "barhinge.model.model",
@@ -49,7 +52,7 @@ __all__ = [
 def __getattr__(name: str) -> Any:
     if name in _LAZY:
         module = importlib.import_module(_LAZY[name])
-        value = module if name == "patterns" else getattr(module, name)
+        value = module if module.__name__ == f"barhinge.{name}" else getattr(module, name)
         globals()[name] = value
         return value
     raise AttributeError(f"module 'barhinge' has no attribute {name!r}")

@@ -107,6 +107,11 @@ class Assembler:
         self.indptr = seg_start.astype(itype)
         self.nnz = total
 
+    def __getstate__(self) -> dict:
+        state = dict(self.__dict__)
+        state.pop("_flat", None)  # scratch buffer: not worth pickling
+        return state
+
     def force(self, element_vectors: list[np.ndarray]) -> np.ndarray:
         """(n_dof,) sum of entry-major element vectors ``(3 * nodes, n_el)`` of each group."""
         val = np.concatenate([f.ravel() for f in element_vectors])

@@ -355,6 +355,8 @@ def dof(
     t.add_row("counted DOF (Tachi 2010)", *[str(r.counted_dof) for r in reps])
     t.add_row("DOF from rank", *[f"{r.global_dof} (rank {r.rank}, {r.method})" for r in reps])
     t.add_row("redundant constraints", *[str(r.redundant) for r in reps])
+    t.add_row("smallest non-zero σ / zero threshold",
+              *[f"{r.sigma_gap:.2e} / {r.tolerance:.1e}" for r in reps])  # fmt: skip
 
     def hist(a) -> str:
         import numpy as np
@@ -739,25 +741,27 @@ def verify_cmd(
         for col, just in (
             ("case", "left"),
             ("quantity", "left"),
+            ("", "center"),
             ("reference", "right"),
             ("computed", "right"),
             ("rel. error", "right"),
             ("tolerance", "right"),
             ("time (s)", "right"),
-            ("", "center"),
         ):
-            t.add_column(col, justify=just, no_wrap=col in ("case", "quantity"))  # type: ignore[arg-type]
+            num = col not in ("case", "quantity")
+            width = 4 if not col else 7 if num else (12 if col == "case" else 10)
+            t.add_column(col, justify=just, no_wrap=num, min_width=width)  # type: ignore[arg-type]
         last = None
         for c in checks:
             t.add_row(
                 c.case if c.case != last else "",
                 c.quantity,
+                "[green]pass[/]" if c.passed else "[bold red]FAIL[/]",
                 f"{c.reference:.7g}",
                 f"{c.computed:.7g}",
                 f"{c.error:.1e}",
                 f"{c.tolerance:.0e}",
                 f"{c.time_s:.2f}" if c.case != last else "",
-                "[green]pass[/]" if c.passed else "[bold red]FAIL[/]",
             )
             last = c.case
         console.print(t)

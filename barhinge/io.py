@@ -88,18 +88,9 @@ def _model_triangles(hinges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def _element_energies(model: Any, X: np.ndarray, rho: np.ndarray):
     """(n_bars,), (n_hinges,) stored energy of every bar and hinge with the model's own laws
-    (:mod:`barhinge.kernels.laws`)."""
-    from barhinge.kernels.geometry import bar_strain
-    from barhinge.kernels.laws import bar_linear, hinge_linear, hinge_penetration
-
-    eps = bar_strain(X, model.bars, model.bar_L0, getattr(model, "strain", "green"))
-    _, _, Wb = bar_linear(eps, model.bar_EA, model.bar_L0)
-    _, _, Wh = hinge_linear(rho, model.rest_angle, model.hinge_k)
-    if getattr(model, "fold_law", "linear") == "penetration":
-        f = np.asarray(model.hinge_kind) == "fold"
-        lo, hi = model.fold_limits
-        Wh[f] = hinge_penetration(rho[f], model.rest_angle[f], model.hinge_k[f], lo, hi)[2]
-    return Wb, Wh
+    (per-hinge penetration limits included); ``rho`` is unused, kept for the call sites."""
+    del rho
+    return model.element_energies(X)
 
 
 def _pair_index(pairs: np.ndarray, n: int) -> np.ndarray:

@@ -260,12 +260,19 @@ def _miura_rigid() -> dict[str, float]:
     sign = math.copysign(1.0, float(cp.fold_angles[ez]))
     d = 0.05
     tab = np.r_[np.linspace(10.0, 2 * (_MT - d), 5), 2 * _MT, 2 * (_MT + d)]
-    path = bh.rigid_fold(cp, bh.Actuators(edges=[ez], table_deg=sign * tab[:, None]), steps=len(tab))
+    path = bh.rigid_fold(
+        cp, bh.Actuators(edges=[ez], table_deg=sign * tab[:, None]), steps=len(tab)
+    )
     out = _miura_dims(path.X[-2], lay.ni)
     out["rho_straight_deg"] = abs(float(path.fold_angles_deg[-2, es]))
     lo, hi = _miura_dims(path.X[-3], lay.ni), _miura_dims(path.X[-1], lay.ni)
     # central difference of ln L against ln S (error O(d^2) ~ 1e-6)
     out["nu_SL"] = -math.log(hi["L"] / lo["L"]) / math.log(hi["S"] / lo["S"])
+    # the same through the library's analysis (pairs one period apart, np.gradient)
+    from barhinge.analysis.poisson import grid_pairs, periodic_poisson
+
+    pairs_L, pairs_S = grid_pairs(cp)
+    out["nu_SL_analysis"] = float(periodic_poisson(path, pairs_S, pairs_L).nu[-2])
     return out
 
 
@@ -294,6 +301,11 @@ _miura_rigid_case = Case(
         Quantity(
             "nu_SL", _SG["nu_SL"], 1e-5,
             "central difference over theta +- 0.05 deg: truncation O(d^2) ~ 2e-6",
+            "nu_SL = -cos^2(theta) tan^2(gamma)",
+        ),
+        Quantity(
+            "nu_SL_analysis", _SG["nu_SL"], 1e-5,
+            "barhinge.analysis.poisson.periodic_poisson, central difference: O(d^2) ~ 2e-6",
             "nu_SL = -cos^2(theta) tan^2(gamma)",
         ),
     ),
@@ -341,7 +353,10 @@ _miura_bh_case = Case(
 _D4A, _D4B = 70.0, 50.0
 
 
-def _degree4_pattern(fold_angles=None):
+def degree4_pattern(fold_angles=None):
+    """A flat-foldable degree-4 vertex, sector angles 70, 50, 110, 130 deg; creases 0..3 at
+    directions 0, 70, 120, 230 deg, boundary edges 4..7. Assignment M V M M (first branch);
+    with ``fold_angles`` (target angles of creases 0..3, choosing a branch) M M V M."""
     from barhinge.pattern.crease import CreasePattern
 
     a, b = math.radians(_D4A), math.radians(_D4B)
@@ -365,12 +380,12 @@ def _degree4() -> dict[str, float]:
     import barhinge as bh
 
     out = {}
-    p1 = bh.rigid_fold(_degree4_pattern(), [0], targets_deg=[_RHO1], steps=6)
+    p1 = bh.rigid_fold(degree4_pattern(), [0], targets_deg=[_RHO1], steps=6)
     r = np.radians(p1.fold_angles_deg[-1, :4])
     out["mode1_multiplier"] = math.tan(r[1] / 2) / math.tan(r[0] / 2)
     q = _mult2()
     r2 = math.degrees(2 * math.atan(q * math.tan(math.radians(-20.0) / 2)))
-    cp2 = _degree4_pattern([-20.0, r2, 20.0, r2])  # branch direction, not the result
+    cp2 = degree4_pattern([-20.0, r2, 20.0, r2])  # branch direction, not the result
     p2 = bh.rigid_fold(cp2, [0], targets_deg=[_RHO1], steps=6)
     r = np.radians(p2.fold_angles_deg[-1, :4])
     out["mode2_multiplier"] = math.tan(r[1] / 2) / math.tan(r[0] / 2)
@@ -570,6 +585,60 @@ _fold_case = Case(
     ),
 )  # fmt: skip
 
+
+def _hinge_cantilever() -> dict[str, float]:
+    """The two-panel model of ``fold_actuator_moment``: left panel clamped, a line load at
+    the free edge of the right panel (distance 1 from the crease); linear effective
+    stiffness (barhinge.analysis.stiffness.effective_stiffness) of the free edge. The panel
+    also bends along its diagonal, a compliance proportional to 1/ratio (ratio = panel / fold
+    stiffness): computed at ratios 1e4 and 1e5 and extrapolated to the rigid panel."""
+    import barhinge as bh
+    from barhinge.analysis.stiffness import effective_stiffness
+    from barhinge.pattern.crease import CreasePattern
+
+    V = [[-1, 0], [0, 0], [1, 0], [1, 1], [0, 1], [-1, 1]]
+    E = [[0, 1], [1, 2], [2, 3], [3, 4], [4, 5], [5, 0], [1, 4]]
+    cp = CreasePattern(
+        vertices=V, edges=E, assignment=list("BBBBBBV"), faces=[[0, 1, 4, 5], [1, 2, 3, 4]]
+    )
+    k = []
+    for ratio in (1e4, 1e5):
+        model = bh.BarHingeModel.from_pattern(
+            cp, scheme="N4B5", material=_material(), fold_stiffness=_K_FOLD, stiffness_ratio=ratio
+        )
+        fixed = np.zeros((model.n_nodes, 3), bool)
+        fixed[[0, 1, 4, 5]] = True
+        P = np.zeros((model.n_nodes, 3))
+        P[[2, 3], 2] = 0.5
+        k.append(effective_stiffness(model, P, fixed, at=np.array([2, 3])).stiffness)
+    # compliance c(r) = c0 + c1 / r: Richardson extrapolation to r -> infinity
+    c0 = (10.0 / k[1] - 1.0 / k[0]) / 9.0
+    return {"edge_stiffness": 1.0 / c0, "edge_stiffness_ratio_1e5": k[1]}
+
+
+_cantilever_case = Case(
+    name="hinge_cantilever",
+    citation="Howell 2001, Compliant Mechanisms (pseudo-rigid-body model: rigid link on a "
+    "torsional spring, M = K theta); Filipov et al. 2017 (fold hinge K = k L)",
+    description=(
+        "Two 1x1 N4B5 panels, one crease (L=1, k=2), left panel clamped, unit load at the "
+        "free edge; linear stiffness of the edge, extrapolated to rigid panels"
+    ),
+    compute=_hinge_cantilever,
+    quantities=(
+        Quantity(
+            "edge_stiffness", _K_FOLD * 1.0 / 1.0**2, 1e-6,
+            "extrapolated in 1/ratio from 1e4 and 1e5: O(1/ratio^2) remainder; measured 2e-8",
+            "K_edge = k L_crease / L_panel^2",
+        ),
+        Quantity(
+            "edge_stiffness_ratio_1e5", _K_FOLD, 5e-5,
+            "panel diagonal bending at stiffness ratio 1e5: 1/ratio; measured 9.5e-6",
+            "K_edge = k L_crease / L_panel^2",
+        ),
+    ),
+)  # fmt: skip
+
 _SW, _SH, _SN = 1.0, 1.2, 4  # strip of 4 panels 1 x 1.2 (x by y)
 
 
@@ -587,7 +656,9 @@ def _membrane_strip() -> dict[str, float]:
     asg = ["B"] * (2 * n) + ["B"] + ["F"] * (n - 1) + ["B"]
     cp = CreasePattern(vertices=V, edges=edges, assignment=asg, faces=faces)
     mat = _material()
-    model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=mat, bar_calibration="filipov")
+    model = bh.BarHingeModel.from_pattern(
+        cp, scheme="N5B8", material=mat, bar_calibration="filipov"
+    )
     nn = model.n_nodes
     S = np.zeros((nn, 3), bool)
     S[:, 2] = True
@@ -655,9 +726,7 @@ _filipov_case = Case(
     quantities=(
         Quantity("A_W", _F17["A_W"], 1e-8, _LSQ, "A_W = t (H^2 - nu W^2) / (2 H (1 - nu^2))"),
         Quantity("A_H", _F17["A_H"], 1e-8, _LSQ, "A_H = t (W^2 - nu H^2) / (2 W (1 - nu^2))"),
-        Quantity(
-            "A_X", _F17["A_X"], 1e-8, _LSQ, "A_X = nu t (W^2 + H^2)^1.5 / (2 W H (1 - nu^2))"
-        ),
+        Quantity("A_X", _F17["A_X"], 1e-8, _LSQ, "A_X = nu t (W^2 + H^2)^1.5 / (2 W H (1 - nu^2))"),
     ),
 )
 
@@ -766,6 +835,7 @@ CASES: dict[str, Case] = {
         _curvature_case,
         _dof_case,
         _fold_case,
+        _cantilever_case,
         _strip_case,
         _filipov_case,
         _vm_case,

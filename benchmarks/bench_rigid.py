@@ -19,6 +19,7 @@ import numpy as np
 
 import barhinge as bh
 from barhinge.kinematics.constraints import RigidConstraints
+from barhinge.kinematics.path import RigidOptions
 
 
 def run(n: int, steps: int) -> dict:
@@ -31,7 +32,7 @@ def run(n: int, steps: int) -> dict:
     rc = RigidConstraints.from_pattern(cp)
     _ = rc.face_tree
     setup = time.perf_counter() - t0
-    opt = bh.kinematics.RigidOptions(check_rank=False)
+    opt = RigidOptions(check_rank=False)
     path = bh.rigid_fold(cp, [e], [sign * 120.0], steps=steps, options=opt)
     dt = np.diff(path.wall_time)
     return {

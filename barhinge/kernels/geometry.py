@@ -20,7 +20,7 @@ Conventions
 Derivatives
 -----------
 The gradient is the classical one for a dihedral angle (Bridson et al. 2003; Liu & Paulino
-2017, Proc. R. Soc. A 473:20170348, Eqs. 8-9; Filipov et al. 2017, IJSS, appendix), written
+2017, Proc. R. Soc. A 473:20170348; Filipov et al. 2017, IJSS 124:26-45), written
 in this module's node order::
 
     d rho / d x_k =  |a| n_L / |n_L|^2
@@ -30,7 +30,7 @@ in this module's node order::
 
 The Hessian is obtained here by exact differentiation of these expressions (chain rule on
 ``n_L``, ``n_R``, ``|a|``, ``t_k``, ``t_l``); :mod:`barhinge.kernels.reference` implements
-Liu & Paulino's closed-form Hessian (their Eq. 10-13) independently, and the tests compare the
+Liu & Paulino's closed-form Hessian blocks independently, and the tests compare the
 two and both against finite differences.
 """
 

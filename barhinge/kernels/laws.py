@@ -43,7 +43,7 @@ def hinge_penetration(
     rho_max: float | np.ndarray = 0.75 * np.pi,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Penetration-preventing fold law of Liu & Paulino (2017, Proc. R. Soc. A 473:20170348,
-    Eq. 14), written in the fold angle ``rho = pi - theta``.
+    rotational spring law), written in the fold angle ``rho = pi - theta``.
 
     Linear ``M = k (rho - rho0)`` for ``rho_min <= rho <= rho_max``; beyond the limits the
     moment follows a tangent branch that is C1-continuous at the limit and tends to infinity

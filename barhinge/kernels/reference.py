@@ -4,8 +4,8 @@ Plain Python loops over elements, 3-vectors and 3x3 blocks only, and -- where po
 different formulation from the vectorised kernels:
 
 * hinge angle and derivatives follow Liu & Paulino (2017, Proc. R. Soc. A 473:20170348,
-  Sec. 3(b), Eqs. 8-13) in *their* node labelling (wing ``p``, axis ``q -> r``, wing ``s``,
-  ``m = r_pq x r_rq``, ``n = r_rq x r_rs``), with their explicit closed-form Hessian blocks
+  rotational spring element) in *their* node labelling (wing ``p``, axis ``q -> r``, wing
+  ``s``, ``m = r_pq x r_rq``, ``n = r_rq x r_rs``), with their explicit closed-form Hessian blocks
   (in :mod:`barhinge.kernels.geometry` the Hessian is derived by the chain rule on the
   gradient and assembled in a different block form);
 * bar derivatives are written out per bar with both strain measures;
@@ -80,7 +80,7 @@ def hinge_reference(xi, xj, xk, xl) -> tuple[float, np.ndarray, np.ndarray]:
     if rho <= -math.pi:
         rho += 2.0 * math.pi
 
-    # gradient (Liu & Paulino Eq. 9)
+    # gradient (Liu & Paulino 2017)
     dp = lrq / mm * m
     ds = -lrq / nn * n
     A = (r_pq @ r_rq) / (lrq * lrq)
@@ -88,7 +88,7 @@ def hinge_reference(xi, xj, xk, xl) -> tuple[float, np.ndarray, np.ndarray]:
     dq = (A - 1.0) * dp - B * ds
     dr = (B - 1.0) * ds - A * dp
 
-    # Hessian blocks (Liu & Paulino Eq. 10-13); H_ab = d2 theta / dx_a dx_b
+    # Hessian blocks (Liu & Paulino 2017); H_ab = d2 theta / dx_a dx_b
     def sym(v, w):
         return _outer(v, w) + _outer(w, v)
 

@@ -188,23 +188,28 @@ class RigidConstraints:
         corner_pts: list[tuple[int, int, int]] = []  # (vertex, next, prev) of each sector
         interior = np.zeros(pat.n_vertices, bool)
         interior[pat.interior_vertices] = True
-        for v in np.flatnonzero(interior):
-            corners = pat.vertex_corners[v]
-            if len(corners) != pat.vertex_degree[v] or len(corners) < 3:
+        ok_edge = ((var_of_edge >= 0) & (EF >= 0).all(1)).tolist()
+        var_list = var_of_edge.tolist()
+        faces = pat.faces
+        corners_of = pat.vertex_corners
+        degree = pat.vertex_degree.tolist()
+        for v in np.flatnonzero(interior).tolist():
+            corners = corners_of[v]
+            if len(corners) != degree[v] or len(corners) < 3:
                 continue  # open fan (cut) or degenerate: not a closed loop
             lv, cp_ = [], []
             ok = True
             for fi, p in corners:
-                f = pat.faces[fi]
+                f = faces[fi]
                 nxt, prv = f[(p + 1) % len(f)], f[p - 1]
-                e = idx[(min(v, nxt), max(v, nxt))]
-                if var_of_edge[e] < 0 or (EF[e] < 0).any():
+                e = idx[(v, nxt) if v < nxt else (nxt, v)]
+                if not ok_edge[e]:
                     ok = False
                     break
-                lv.append(int(var_of_edge[e]))
-                cp_.append((int(v), nxt, prv))
+                lv.append(var_list[e])
+                cp_.append((v, nxt, prv))
             if ok:
-                verts.append(int(v))
+                verts.append(v)
                 loops.append(lv)
                 corner_pts.extend(cp_)
         D = max((len(lv) for lv in loops), default=0)
@@ -433,7 +438,15 @@ class FaceTree:
             if rc.var_of_edge[e] >= 0:
                 adj[fl].append((int(fr), int(e)))
                 adj[fr].append((int(fl), int(e)))
-        cent = np.array([X0[list(f)].mean(0) for f in pat.faces])
+        sizes = np.fromiter((len(f) for f in pat.faces), dtype=np.int64, count=nf)
+        flat_idx = np.fromiter((i for f in pat.faces for i in f), dtype=np.int64)
+        owner = np.repeat(np.arange(nf), sizes)
+        cent = (
+            np.stack(
+                [np.bincount(owner, weights=X0[flat_idx, k], minlength=nf) for k in range(3)], 1
+            )
+            / sizes[:, None]
+        )
         order_pref = np.argsort(np.linalg.norm(cent - cent.mean(0), axis=1), kind="stable")
         depth = -np.ones(nf, dtype=np.int64)
         parent = -np.ones(nf, dtype=np.int64)

@@ -60,6 +60,9 @@ class DofReport:
         Numerical rank of the loop-closure Jacobian.
     tolerance : float
         Absolute singular-value threshold used for the rank.
+    sigma_gap : float
+        Smallest singular value counted as non-zero (compare with ``tolerance`` to judge how
+        clear-cut the rank is; NaN if unknown).
     method : str
         ``"svd"`` (dense) or ``"sparse-eigsh"``.
     n_variables, n_equations, n_interior_vertices : int
@@ -88,6 +91,7 @@ class DofReport:
     redundant: int
     rank: int
     tolerance: float
+    sigma_gap: float
     method: str
     n_variables: int
     n_equations: int
@@ -120,6 +124,7 @@ class DofReport:
                 "redundant": r.redundant,
                 "rank": r.rank,
                 "tolerance": r.tolerance,
+                "sigma_gap": r.sigma_gap,
                 "method": r.method,
                 "n_variables": r.n_variables,
                 "n_equations": r.n_equations,
@@ -278,6 +283,7 @@ def _report(rc: RigidConstraints, rho: np.ndarray, *, prefer: Any, tol: float | 
         redundant=int(g - counted),
         rank=ns.rank,
         tolerance=ns.tolerance,
+        sigma_gap=ns.sigma_gap,
         method=ns.method,
         n_variables=rc.n_var,
         n_equations=rc.n_eq,

@@ -58,8 +58,8 @@ def test_laws_equal_scalar_oracle() -> None:
 
 
 def test_penetration_law_is_c1_linear_inside_and_blows_up_at_pi() -> None:
-    """Liu & Paulino (2017) Eq. 14: linear between the limits, moment and tangent continuous
-    at the limits, moment -> +-infinity as rho -> +-pi."""
+    """Liu & Paulino (2017) penetration law: linear between the limits, moment and tangent
+    continuous at the limits, moment -> +-infinity as rho -> +-pi."""
     k, r0 = 2.0, 0.2
     d = 1e-9
     for lim in (LO, HI):

@@ -179,7 +179,7 @@ def test_sparse_rank_agrees_with_dense_svd():
     null space (flat Miura: first-order DOF 4n - 2 for n x n cells; folded: 1)."""
     from barhinge.kinematics.linalg import null_space
 
-    n = 6
+    n = 4
     cp = bh.patterns.miura(n, n)
     rc = RigidConstraints.from_pattern(cp)
     for rho in (rc.rho0, folded_sample(rc)):

@@ -138,7 +138,29 @@ def test_locking_threshold_stops_the_path():
     cp = bh.patterns.miura(2, 2)
     e = int(bh.patterns.miura_layout(2, 2).interior_zigzag_edges[0])
     sign = 1.0 if cp.assignment[e] == "V" else -1.0
-    opt = bh.kinematics.RigidOptions(lock_deg=120.0)
+    from barhinge.kinematics.path import RigidOptions
+
+    opt = RigidOptions(lock_deg=120.0)
     with pytest.raises(bh.ConvergenceError, match="locked") as info:
         bh.rigid_fold(cp, [e], [sign * 150.0], steps=5, options=opt)
     assert info.value.last_state.kind == "rigid"
+
+
+def test_corrector_converges_quadratically():
+    """Gauss-Newton on a consistent system with an exact Jacobian, solved inexactly with
+    forcing term eta_k ~ |r_k| (Dembo, Eisenstat & Steihaug 1982): r_{k+1} <= C r_k^2."""
+    from barhinge.kinematics.path import RigidOptions, RigidSolver
+
+    cp = bh.patterns.miura(4, 4, fold=40.0)
+    rc = RigidConstraints.from_pattern(cp)
+    e = int(bh.patterns.miura_layout(4, 4).interior_zigzag_edges[3])
+    act = rc.var_of_source_edge[[e]]
+    solver = RigidSolver(rc, act, RigidOptions(tol=1e-15, max_iter=10))
+    x = rc.rho0 + 3e-3 * np.random.default_rng(0).standard_normal(rc.n_var)
+    x[act] = rc.rho0[act]
+    out, hist, ok = solver.corrector(x)
+    assert ok and len(hist) <= 6
+    h = np.array(hist)
+    big = h[:-1] > 1e-14
+    assert np.all(h[1:][big] <= 50.0 * h[:-1][big] ** 2)
+    np.testing.assert_allclose(out, rc.rho0, rtol=0, atol=1e-12)  # the 1-DOF state is unique

@@ -186,3 +186,14 @@ def test_with_and_stiffened_share_the_scatter_maps_and_scale_the_tangent() -> No
     assert np.allclose(m2.tangent(X).toarray(), 2.0 * K.toarray(), rtol=1e-13, atol=0)
     with pytest.raises(bh.ConfigError):
         m.with_(hinge_k=np.ones(3))
+
+
+def test_model_pickles_and_evaluates_the_same() -> None:
+    import pickle
+
+    m = MODELS[2]
+    X = perturbed(m, 5)
+    ev = m.evaluate(X)
+    m2 = pickle.loads(pickle.dumps(m))
+    ev2 = m2.evaluate(X)
+    assert ev2.energy == ev.energy and np.array_equal(ev2.K.toarray(), ev.K.toarray())

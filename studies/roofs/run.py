@@ -1,0 +1,155 @@
+"""Folded-roof stiffness comparison: roofs of one span, sheet material and thickness folded
+from different patterns (two Miura-ori, an arched Miura, Yoshimura, corrugation, Ron Resch,
+waterbomb), pinned along their two supported edges, under self-weight and a uniform load;
+stiffness (total uniform load / largest deflection) per unit width and per unit sheet area,
+and the peak bar strain, as functions of the fold state. Independent check: the corrugated
+(pleated) roof against classical beam theory, with the panels cut into 1, 2, 4 strips.
+
+Geometry, loads and the analysis: ``roofs.py``. Results at module level: ``RESULTS`` (list of
+dicts, one per family and fold state), ``FAILED`` (family, state, reason), ``BEAM`` (list of
+beam-check dicts).
+
+Run: ``python studies/roofs/run.py [--quick]``; full mode writes docs/roofs.csv,
+docs/img/roofs.png and prints the markdown table of docs/roofs.md. Importing the module runs
+the quick mode (a few states per family).
+"""
+
+from __future__ import annotations
+
+import csv
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+import roofs  # noqa: E402
+
+MAIN = __name__ == "__main__"
+QUICK = not MAIN or "--quick" in sys.argv
+ROOT = HERE.parents[1]
+
+if QUICK:
+    STATES = {"miura60": [30.0, 60.0], "miura75": [45.0], "miura_arc": [60.0],
+              "yoshimura": [20.0, 40.0], "pleats": [60.0, 120.0], "resch": [0.3],
+              "waterbomb": [0.3]}  # fmt: skip
+    BEAM_FOLDS, BEAM_STRIPS = [90.0], [1, 2, 4]
+else:
+    STATES = {f: spec["states"] for f, spec in roofs.FAMILIES.items()}
+    BEAM_FOLDS, BEAM_STRIPS = [60.0, 90.0, 120.0], [1, 2, 4]
+
+
+def run() -> tuple[list[dict], list[tuple], list[dict]]:
+    from barhinge.errors import BarhingeError
+
+    results, failed = [], []
+    for fam, states in STATES.items():
+        for st in states:
+            t0 = time.perf_counter()
+            try:
+                rec = roofs.analyse(fam, st)
+            except (BarhingeError, np.linalg.LinAlgError, ArithmeticError) as exc:
+                failed.append((fam, st, f"{type(exc).__name__}: {str(exc).splitlines()[0]}"))
+                continue
+            rec["time_s"] = time.perf_counter() - t0
+            results.append(rec)
+    beam = [roofs.pleat_beam_check(f, n) for f in BEAM_FOLDS for n in BEAM_STRIPS]
+    return results, failed, beam
+
+
+RESULTS, FAILED, BEAM = run()
+COLUMNS = ("family", "state", "mean_fold_deg", "span", "width", "depth", "sheet_area",
+           "plan_area", "n_nodes", "deflection_q", "deflection_sw", "stiffness",
+           "stiffness_per_width", "stiffness_per_sheet_area", "peak_strain",
+           "equilibrium_error", "time_s")  # fmt: skip
+
+
+def write_csv(path: Path) -> None:
+    with path.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(COLUMNS)
+        for r in RESULTS:
+            w.writerow([f"{r[c]:.6g}" if isinstance(r[c], float) else r[c] for c in COLUMNS])
+
+
+def table() -> str:
+    """Markdown table of every roof (docs/roofs.md)."""
+    lines = [
+        "| family | state | mean fold (deg) | width (m) | depth (m) | sheet / plan area | "
+        "deflection, q (mm) | deflection, self-weight (mm) | k / width (kN/m/m) | "
+        "k / sheet area (kN/m/m^2) | peak bar strain |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in RESULTS:
+        lines.append(
+            f"| {r['family']} | {r['state']:g} | {r['mean_fold_deg']:.1f} | {r['width']:.2f} | "
+            f"{r['depth']:.2f} | {r['sheet_area'] / r['plan_area']:.2f} | "
+            f"{1e3 * r['deflection_q']:.1f} | {1e3 * r['deflection_sw']:.2f} | "
+            f"{r['stiffness_per_width'] / 1e3:.1f} | {r['stiffness_per_sheet_area'] / 1e3:.2f} | "
+            f"{r['peak_strain']:.1e} |"
+        )
+    for fam, st, why in FAILED:
+        lines.append(f"| {fam} | {st:g} | failed: {why} |" + " |" * 8)
+    return "\n".join(lines)
+
+
+def beam_table() -> str:
+    lines = ["| fold (deg) | strips per panel | bar-and-hinge k (MN/m) | beam theory k (MN/m) | "
+             "ratio | bending share (beam) |", "|---|---|---|---|---|---|"]  # fmt: skip
+    for b in BEAM:
+        lines.append(f"| {b['fold']:g} | {b['n_strip']} | {b['stiffness'] / 1e6:.2f} | "
+                     f"{b['beam'] / 1e6:.2f} | {b['ratio']:.3f} | {b['bending_share']:.2f} |")  # fmt: skip
+    return "\n".join(lines)
+
+
+def chart(path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 4, figsize=(18, 4.3), layout="constrained")
+    keys = [("stiffness_per_width", "stiffness / width (N/m per m)"),
+            ("stiffness_per_sheet_area", "stiffness / sheet area (N/m per m$^2$)"),
+            ("peak_strain", "peak bar strain (self-weight + q)")]  # fmt: skip
+    for ax, (k, lab) in zip(axes, keys, strict=False):
+        for fam in STATES:
+            rs = sorted((r for r in RESULTS if r["family"] == fam), key=lambda r: r["state"])
+            if rs:
+                ax.plot([r["mean_fold_deg"] for r in rs], [r[k] for r in rs], "o-", label=fam)
+        ax.set_yscale("log")
+        ax.set_xlabel("mean |fold angle| of the creases (deg)")
+        ax.set_ylabel(lab)
+    axes[0].legend(fontsize=8)
+    ax = axes[3]
+    for f in BEAM_FOLDS:
+        bs = [b for b in BEAM if b["fold"] == f]
+        ax.loglog([b["n_strip"] for b in bs], [b["ratio"] - 1 for b in bs], "o-",
+                  label=f"fold {f:g} deg")  # fmt: skip
+    n = np.array(BEAM_STRIPS, float)
+    ax.loglog(n, 1.0 / n**2, "k--", lw=0.8, label="slope -2")
+    ax.set_xlabel("strips per corrugation panel")
+    ax.set_ylabel("k (bar-and-hinge) / k (beam theory) - 1")
+    ax.set_title("corrugated roof vs beam theory", fontsize=10)
+    ax.legend(fontsize=8)
+    fig.suptitle(f"folded roofs, span {roofs.SPAN:g} m, aluminium t = "
+                 f"{1e3 * roofs.MATERIAL['t']:g} mm, q = {roofs.Q:g} N/m$^2$ + self-weight")  # fmt: skip
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+if MAIN:
+    if QUICK:
+        out = HERE / "results-quick"
+        out.mkdir(exist_ok=True)
+        csv_path, png_path = out / "roofs.csv", out / "roofs.png"
+    else:
+        csv_path, png_path = ROOT / "docs" / "roofs.csv", ROOT / "docs" / "img" / "roofs.png"
+    write_csv(csv_path)
+    chart(png_path)
+    print(table())
+    print()
+    print(beam_table())
+    print(f"\nwrote {csv_path} and {png_path}")
