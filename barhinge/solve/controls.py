@@ -134,7 +134,7 @@ class BorderedSystem:
         self.negative_pivots: int | None = None
         self.inertia_seen: list[int | None] = []
         self.Gf: sp.csr_matrix | None = None
-        self.Z: np.ndarray | None = None
+        self.Z: np.ndarray | None = None  # A^-1 G^T (None with a Cholesky half solve)
         self.S_lu = None
 
     # ---------------------------------------------------------------- structure
@@ -216,10 +216,16 @@ class BorderedSystem:
         if na:
             t0 = time.perf_counter()
             self.Gf = terms.G[:, self.free_idx].tocsr()
-            self.Z = np.asarray(self.factor.solve(self.Gf.T.toarray()))
-            if self.Z.ndim == 1:
-                self.Z = self.Z[:, None]
-            S = self.Gf @ self.Z
+            half = getattr(self.factor, "half_solve", None)
+            if half is not None:  # Cholesky: S = W^T W with W = L^-1 P G^T
+                W = half(self.Gf.T.toarray())
+                S = W.T @ W
+                self.Z = None
+            else:
+                self.Z = np.asarray(self.factor.solve(self.Gf.T.toarray()))
+                if self.Z.ndim == 1:
+                    self.Z = self.Z[:, None]
+                S = self.Gf @ self.Z
             S = 0.5 * (S + S.T)
             self.timer.solve += time.perf_counter() - t0
             try:
@@ -252,7 +258,10 @@ class BorderedSystem:
         bx = rhs_x + self.penalty * (self.Gf.T @ rhs_c)
         a0 = np.asarray(self.factor.solve(bx))
         dmu = self.S_inv @ (self.Gf @ a0 - rhs_c)
-        dx = a0 - self.Z @ dmu
+        if self.Z is not None:
+            dx = a0 - self.Z @ dmu
+        else:
+            dx = a0 - np.asarray(self.factor.solve(self.Gf.T @ dmu))
         self.timer.solve += time.perf_counter() - t0
         return dx, dmu
 

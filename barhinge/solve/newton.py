@@ -96,11 +96,15 @@ class _Driver:
         self.work = 0.0
         self._last_sub: dict[str, Any] | None = None
         self._prev: _State | None = None
+        self._prev2: _State | None = None
         self._samples: list[tuple[float, np.ndarray, np.ndarray]] = []
         self.c_scale = 1.0
         self.n_fact_last = 0
         self._inertia: int | None = None
         self.system.track_inertia = scene.control in ("load", "displacement")
+        # what a change of the free-DOF tangent's inertia means under this control: a load
+        # maximum (load control) or a turning point of the controlled displacement
+        self._critical = "limit point" if scene.control == "load" else "snap-back"
 
     # ------------------------------------------------------------ schedules
     def targets(self, t: float) -> np.ndarray:
@@ -130,7 +134,7 @@ class _Driver:
             c = (c + np.pi) % (2 * np.pi) - np.pi
         if self.force_floor is None:
             d = np.abs(ev.K.diagonal())
-            self.force_floor = 1e-9 * float(d.max() if d.size else 1.0) * self.size
+            self.force_floor = 1e-12 * float(d.max() if d.size else 1.0) * self.size
         if self.penalty is None:
             self.penalty = self._auto_penalty(ev.K, terms)
         return _Eval(ev, terms, r, c)
@@ -186,9 +190,20 @@ class _Driver:
         res: list[float] = []
         self.system.inertia_seen = []
         prev = self._prev
-        if prev is not None and prev.t < st.t and o.predictor == "secant":
-            f = (t1 - st.t) / (st.t - prev.t)
-            new = _State(st.x + f * (st.x - prev.x), st.mu + f * (st.mu - prev.mu), lam1, t1)
+        prev2 = self._prev2
+        if prev is not None and prev.t < st.t and o.predictor in ("secant", "quadratic"):
+            if o.predictor == "quadratic" and prev2 is not None and prev2.t < prev.t:
+                # Lagrange extrapolation through the last three converged states
+                ta, tb, tc = prev2.t, prev.t, st.t
+                la = (t1 - tb) * (t1 - tc) / ((ta - tb) * (ta - tc))
+                lb = (t1 - ta) * (t1 - tc) / ((tb - ta) * (tb - tc))
+                lc = (t1 - ta) * (t1 - tb) / ((tc - ta) * (tc - tb))
+                x = la * prev2.x + lb * prev.x + lc * st.x
+                mu = la * prev2.mu + lb * prev.mu + lc * st.mu
+            else:
+                f = (t1 - st.t) / (st.t - prev.t)
+                x, mu = st.x + f * (st.x - prev.x), st.mu + f * (st.mu - prev.mu)
+            new = _State(x, mu, lam1, t1)
             new.x[fixed] = self.fixed_coords(t1)
             n_fact = 0
         else:
@@ -245,8 +260,9 @@ class _Driver:
         bad = [n for n in seen if n != self._inertia]
         if bad:
             raise _Failed(
-                f"limit point: the tangent's negative eigenvalues went from {self._inertia} to "
-                f"{bad[0]} inside the increment (use control = 'arc_length' to pass it)",
+                f"{self._critical}: the tangent's negative eigenvalues went from "
+                f"{self._inertia} to {bad[0]} inside the increment (use control = 'arc_length' "
+                "to pass it)",
                 res,
             )
 
@@ -260,7 +276,7 @@ class _Driver:
         corr = float(np.linalg.norm(new.x - x_pred))
         if corr > step + self.opts.tol_disp * self.size:
             raise _Failed(
-                f"limit point: Newton left the branch (correction {corr:.3g} > predictor step "
+                f"{self._critical}: Newton left the branch (correction {corr:.3g} > predictor step "
                 f"{step:.3g}; use control = 'arc_length' to pass it)",
                 res,
             )
@@ -385,9 +401,10 @@ class _Driver:
         e = self.evaluate(st)
         if self.n_act:
             # multipliers that balance the initial state best (zero for a stress-free start)
+            # least squares min |r_free + G^T mu| through the normal equations (n_act x n_act)
             G = e.terms.G[:, self.free]
-            rf = e.r[self.free]
-            mu, *_ = np.linalg.lstsq(G.T.toarray(), -rf, rcond=None)
+            GGt = (G @ G.T).toarray()
+            mu, *_ = np.linalg.lstsq(GGt, -(G @ e.r[self.free]), rcond=None)
             st.mu = mu
             e = self.evaluate(st)
         return st, e
@@ -405,6 +422,7 @@ class _Driver:
         for s in range(1, steps + 1):
             t_goal = s / steps
             iters, res_all = 0, []
+            critical = ""  # a limit-point diagnosis from any attempt since the last success
             while st.t < t_goal - 1e-12 * h0:
                 h_try = min(h, t_goal - st.t)
                 t1 = t_goal if h_try >= t_goal - st.t - 1e-12 * h0 else st.t + h_try
@@ -414,12 +432,26 @@ class _Driver:
                     log.debug(
                         "step %d: increment to t=%.6g failed (%s); cutting back", s, t1, f.why
                     )
+                    if f.why.startswith(self._critical):
+                        critical = f.why
+                    elif self.system.track_inertia and self._inertia is not None:
+                        seen = [n for n in self.system.inertia_seen if n is not None]
+                        bad = [n for n in seen if n != self._inertia]
+                        if bad:
+                            critical = (
+                                f"{self._critical}: the tangent's negative eigenvalues went from "
+                                f"{self._inertia} to {bad[0]} while iterating ({f.why}); use "
+                                "control = 'arc_length' to pass it"
+                            )
                     h = h_try / 2
                     if h < h_min * (1 - 1e-9):
-                        raise self.fail(s, st.lam, f.why, f.residuals) from None
+                        # near a critical point the smallest increments may simply find no
+                        # solution; name the critical point if one was detected on the way
+                        raise self.fail(s, st.lam, critical or f.why, f.residuals) from None
                     continue
                 self._work_simpson(new, e_new)
-                self._prev, st = st, new
+                critical = ""
+                self._prev2, self._prev, st = self._prev, st, new
                 self._inertia = self.system.negative_pivots
                 iters += self.n_fact_last
                 res_all.extend(res)
@@ -460,11 +492,20 @@ class _Driver:
         the last interval (exact for the cubic integrand: third-order accurate); the
         trapezoidal rule on the first increment."""
         if not self._samples:
-            st0 = _State(self.records[0]["X"].ravel(), -self.records[0]["moments"],
-                          self.records[0]["lam"], 0.0)
+            st0 = _State(
+                self.records[0]["X"].ravel(),
+                -self.records[0]["moments"],
+                self.records[0]["lam"],
+                0.0,
+            )
             R0 = self.records[0]["R"].ravel()
-            self._samples.append((0.0, np.concatenate([st0.x, self.records[0]["rho"]]),
-                                  np.concatenate([st0.lam * self.P + R0, -st0.mu])))
+            self._samples.append(
+                (
+                    0.0,
+                    np.concatenate([st0.x, self.records[0]["rho"]]),
+                    np.concatenate([st0.lam * self.P + R0, -st0.mu]),
+                )
+            )
         self._samples.append(self._work_sample(new.t, new, e_new))
         self._samples = self._samples[-3:]
         if len(self._samples) == 2:

@@ -28,7 +28,7 @@ class SolverOptions:
     tol_angle : float
         Absolute tolerance on the actuator constraints ``|rho_a - rho_target|`` (radians).
     force_floor : float or None
-        Absolute force scale below which residuals count as zero (default: ``1e-9`` times the
+        Absolute force scale below which residuals count as zero (default: ``1e-12`` times the
         largest diagonal entry of the first tangent times ``size``).
     max_iter : int
         Newton iterations per increment before the increment is cut back.
@@ -49,7 +49,8 @@ class SolverOptions:
         ``"auto"`` scales it to the tangent; 0 disables it.
     predictor : str
         ``"secant"`` (extrapolate the last two converged states; tangent step for the first
-        increment) or ``"tangent"`` (always a linearised step at the last converged state).
+        increment), ``"quadratic"`` (through the last three) or ``"tangent"`` (always a
+        linearised step at the last converged state).
     line_search : int
         Maximum halvings of a Newton correction in the backtracking line search on
         ``|r|^2 + (s c)^2`` (0 = plain Newton, the default: on stiff-bar / soft-fold
@@ -66,11 +67,11 @@ class SolverOptions:
     force_floor: float | None = None
     max_iter: int = 25
     max_cutbacks: int = 8
-    grow_iters: int = 4
+    grow_iters: int = 6
     divergence_ratio: float = 1e4
     linear_solver: str = "auto"
     augmentation: float | str = "auto"
-    predictor: str = "secant"
+    predictor: str = "quadratic"
     line_search: int = 0
     arc_length_increment: float | None = None
     max_arc_steps: int | None = None
@@ -86,9 +87,10 @@ class SolverOptions:
                 raise ConfigError(f"solver option {name} = {v!r}; expected an integer >= 1")
         if not (isinstance(self.max_cutbacks, int) and self.max_cutbacks >= 0):
             raise ConfigError(f"solver option max_cutbacks = {self.max_cutbacks!r}; expected >= 0")
-        if self.predictor not in ("secant", "tangent"):
+        if self.predictor not in ("secant", "quadratic", "tangent"):
             raise ConfigError(
-                f"solver option predictor = {self.predictor!r}; expected 'secant' or 'tangent'"
+                f"solver option predictor = {self.predictor!r}; "
+                "expected 'secant', 'quadratic' or 'tangent'"
             )
         if not (isinstance(self.line_search, int) and self.line_search >= 0):
             raise ConfigError(f"solver option line_search = {self.line_search!r}; expected >= 0")

@@ -1,13 +1,15 @@
 """Folded-roof stiffness comparison: roofs of one span, sheet material and thickness folded
 from different patterns (two Miura-ori, an arched Miura, Yoshimura, corrugation, Ron Resch,
 waterbomb), pinned along their two supported edges, under self-weight and a uniform load;
-stiffness (total uniform load / largest deflection) per unit width and per unit sheet area,
+stiffness (total uniform load / its load-weighted mean deflection) per unit width and per
+unit sheet area,
 and the peak bar strain, as functions of the fold state. Independent check: the corrugated
-(pleated) roof against classical beam theory, with the panels cut into 1, 2, 4 strips.
+(pleated) roof against classical beam theory, with the panels cut into 1, 2, 4 strips, and
+the flat sheet (baseline) against plate-strip theory.
 
 Geometry, loads and the analysis: ``roofs.py``. Results at module level: ``RESULTS`` (list of
 dicts, one per family and fold state), ``FAILED`` (family, state, reason), ``BEAM`` (list of
-beam-check dicts).
+beam-check dicts), ``PLATE`` (flat-sheet checks).
 
 Run: ``python studies/roofs/run.py [--quick]``; full mode writes docs/roofs.csv,
 docs/img/roofs.png and prints the markdown table of docs/roofs.md. Importing the module runs
@@ -32,13 +34,22 @@ QUICK = not MAIN or "--quick" in sys.argv
 ROOT = HERE.parents[1]
 
 if QUICK:
-    STATES = {"miura60": [30.0, 60.0], "miura75": [45.0], "miura_arc": [60.0],
-              "yoshimura": [20.0, 40.0], "pleats": [60.0, 120.0], "resch": [0.3],
-              "waterbomb": [0.3]}  # fmt: skip
+    STATES = {
+        "miura60": [30.0, 60.0],
+        "miura75": [45.0],
+        "miura_arc": [60.0],
+        "yoshimura": [20.0, 40.0],
+        "pleats": [60.0, 120.0],
+        "resch": [0.3],
+        "waterbomb": [0.3],
+        "flat": [0.0],
+    }
     BEAM_FOLDS, BEAM_STRIPS = [90.0], [1, 2, 4]
+    PLATE_STRIPS = [1]
 else:
     STATES = {f: spec["states"] for f, spec in roofs.FAMILIES.items()}
     BEAM_FOLDS, BEAM_STRIPS = [60.0, 90.0, 120.0], [1, 2, 4]
+    PLATE_STRIPS = [1, 2, 4]
 
 
 def run() -> tuple[list[dict], list[tuple], list[dict]]:
@@ -56,14 +67,32 @@ def run() -> tuple[list[dict], list[tuple], list[dict]]:
             rec["time_s"] = time.perf_counter() - t0
             results.append(rec)
     beam = [roofs.pleat_beam_check(f, n) for f in BEAM_FOLDS for n in BEAM_STRIPS]
-    return results, failed, beam
+    plate = [roofs.flat_plate_check(n) for n in PLATE_STRIPS]
+    plate.append(roofs.flat_plate_check(1, rigid_panels=True))
+    return results, failed, beam, plate
 
 
-RESULTS, FAILED, BEAM = run()
-COLUMNS = ("family", "state", "mean_fold_deg", "span", "width", "depth", "sheet_area",
-           "plan_area", "n_nodes", "deflection_q", "deflection_sw", "stiffness",
-           "stiffness_per_width", "stiffness_per_sheet_area", "peak_strain",
-           "equilibrium_error", "time_s")  # fmt: skip
+RESULTS, FAILED, BEAM, PLATE = run()
+COLUMNS = (
+    "family",
+    "state",
+    "mean_fold_deg",
+    "span",
+    "width",
+    "depth",
+    "sheet_area",
+    "plan_area",
+    "n_nodes",
+    "deflection_q",
+    "mean_deflection_q",
+    "deflection_sw",
+    "stiffness",
+    "stiffness_per_width",
+    "stiffness_per_sheet_area",
+    "peak_strain",
+    "equilibrium_error",
+    "time_s",
+)
 
 
 def write_csv(path: Path) -> None:
@@ -78,15 +107,16 @@ def table() -> str:
     """Markdown table of every roof (docs/roofs.md)."""
     lines = [
         "| family | state | mean fold (deg) | width (m) | depth (m) | sheet / plan area | "
-        "deflection, q (mm) | deflection, self-weight (mm) | k / width (kN/m/m) | "
-        "k / sheet area (kN/m/m^2) | peak bar strain |",
+        "mean / max deflection, q (mm) | max deflection, self-weight (mm) | "
+        "k / width (kN/m/m) | k / sheet area (kN/m/m^2) | peak bar strain |",
         "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in RESULTS:
         lines.append(
             f"| {r['family']} | {r['state']:g} | {r['mean_fold_deg']:.1f} | {r['width']:.2f} | "
             f"{r['depth']:.2f} | {r['sheet_area'] / r['plan_area']:.2f} | "
-            f"{1e3 * r['deflection_q']:.1f} | {1e3 * r['deflection_sw']:.2f} | "
+            f"{1e3 * r['mean_deflection_q']:.2f} / {1e3 * r['deflection_q']:.1f} | "
+            f"{1e3 * r['deflection_sw']:.2f} | "
             f"{r['stiffness_per_width'] / 1e3:.1f} | {r['stiffness_per_sheet_area'] / 1e3:.2f} | "
             f"{r['peak_strain']:.1e} |"
         )
@@ -96,11 +126,31 @@ def table() -> str:
 
 
 def beam_table() -> str:
-    lines = ["| fold (deg) | strips per panel | bar-and-hinge k (MN/m) | beam theory k (MN/m) | "
-             "ratio | bending share (beam) |", "|---|---|---|---|---|---|"]  # fmt: skip
+    lines = [
+        "| fold (deg) | strips per panel | bar-and-hinge k (MN/m) | beam theory k (MN/m) | "
+        "ratio | bending share (beam) |",
+        "|---|---|---|---|---|---|",
+    ]
     for b in BEAM:
-        lines.append(f"| {b['fold']:g} | {b['n_strip']} | {b['stiffness'] / 1e6:.2f} | "
-                     f"{b['beam'] / 1e6:.2f} | {b['ratio']:.3f} | {b['bending_share']:.2f} |")  # fmt: skip
+        lines.append(
+            f"| {b['fold']:g} | {b['n_strip']} | {b['stiffness'] / 1e6:.2f} | "
+            f"{b['beam'] / 1e6:.2f} | {b['ratio']:.3f} | {b['bending_share']:.2f} |"
+        )
+    return "\n".join(lines)
+
+
+def plate_table() -> str:
+    lines = [
+        "| strips per panel | panels | bar-and-hinge k / width (N/m/m) | plate strip | "
+        "beam strip | ratio to plate |",
+        "|---|---|---|---|---|---|",
+    ]
+    for p in PLATE:
+        lines.append(
+            f"| {p['n_strip']} | {'rigid' if p['rigid_panels'] else 'N5B8 (F17)'} | "
+            f"{p['stiffness_per_width']:.1f} | {p['plate']:.1f} | {p['beam']:.1f} | "
+            f"{p['stiffness_per_width'] / p['plate']:.3f} |"
+        )
     return "\n".join(lines)
 
 
@@ -111,9 +161,11 @@ def chart(path: Path) -> None:
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 4, figsize=(18, 4.3), layout="constrained")
-    keys = [("stiffness_per_width", "stiffness / width (N/m per m)"),
-            ("stiffness_per_sheet_area", "stiffness / sheet area (N/m per m$^2$)"),
-            ("peak_strain", "peak bar strain (self-weight + q)")]  # fmt: skip
+    keys = [
+        ("stiffness_per_width", "stiffness / width (N/m per m)"),
+        ("stiffness_per_sheet_area", "stiffness / sheet area (N/m per m$^2$)"),
+        ("peak_strain", "peak bar strain (self-weight + q)"),
+    ]
     for ax, (k, lab) in zip(axes, keys, strict=False):
         for fam in STATES:
             rs = sorted((r for r in RESULTS if r["family"] == fam), key=lambda r: r["state"])
@@ -126,16 +178,21 @@ def chart(path: Path) -> None:
     ax = axes[3]
     for f in BEAM_FOLDS:
         bs = [b for b in BEAM if b["fold"] == f]
-        ax.loglog([b["n_strip"] for b in bs], [b["ratio"] - 1 for b in bs], "o-",
-                  label=f"fold {f:g} deg")  # fmt: skip
+        ax.loglog(
+            [b["n_strip"] for b in bs], [b["ratio"] - 1 for b in bs], "o-", label=f"fold {f:g} deg"
+        )
     n = np.array(BEAM_STRIPS, float)
     ax.loglog(n, 1.0 / n**2, "k--", lw=0.8, label="slope -2")
+    ax.set_xticks(BEAM_STRIPS, [str(v) for v in BEAM_STRIPS])
+    ax.minorticks_off()
     ax.set_xlabel("strips per corrugation panel")
     ax.set_ylabel("k (bar-and-hinge) / k (beam theory) - 1")
     ax.set_title("corrugated roof vs beam theory", fontsize=10)
     ax.legend(fontsize=8)
-    fig.suptitle(f"folded roofs, span {roofs.SPAN:g} m, aluminium t = "
-                 f"{1e3 * roofs.MATERIAL['t']:g} mm, q = {roofs.Q:g} N/m$^2$ + self-weight")  # fmt: skip
+    fig.suptitle(
+        f"folded roofs, span {roofs.SPAN:g} m, aluminium t = "
+        f"{1e3 * roofs.MATERIAL['t']:g} mm, q = {roofs.Q:g} N/m$^2$ + self-weight"
+    )
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
@@ -152,4 +209,6 @@ if MAIN:
     print(table())
     print()
     print(beam_table())
+    print()
+    print(plate_table())
     print(f"\nwrote {csv_path} and {png_path}")

@@ -62,3 +62,24 @@ def test_form_only_keeps_the_compliant_model_for_loaded_scenes() -> None:
     scene = load_scene(SCENES / "yoshimura_roof.toml")
     assert form_only_model(scene)[0] == "bar-hinge"
     assert form_only_model(load_scene(SCENES / "miura_actuated.toml"))[0] == "rigid"
+
+
+def test_form_only_falls_back_when_rigid_kinematics_cannot_follow(tmp_path: Path) -> None:
+    """A Yoshimura arch (12 rigid DOF) driven by its 9 horizontal creases alone leaves free
+    motions: rigid kinematics refuses (ConfigError naming the missing DOF) and the CLI falls
+    back to the bar-and-hinge solver (helper returns None, nothing written)."""
+    from barhinge.cli import _fold_form_rigid
+
+    cp = bh.patterns.yoshimura(4, 3, fold=5.0)
+    flat = np.asarray(bh.patterns.yoshimura(4, 3).vertices)
+    E = np.asarray(cp.edges)
+    horizontal = np.flatnonzero(
+        (np.abs(flat[E[:, 0], 1] - flat[E[:, 1], 1]) < 1e-9) & np.isin(cp.assignment, ["M", "V"])
+    )
+    assert len(horizontal) == 9
+    model = bh.BarHingeModel.from_pattern(cp, "N5B8")
+    target = np.asarray(bh.patterns.yoshimura(4, 3, fold=30.0).fold_angles)[horizontal]
+    scene = bh.Scene(model, actuators=bh.Actuators(edges=horizontal, targets_deg=target), steps=2)
+    assert form_only_model(scene)[0] == "rigid"
+    assert _fold_form_rigid(scene, tmp_path / "out") is None
+    assert not (tmp_path / "out").exists()
