@@ -103,7 +103,8 @@ class FoldPath:
                 raise ValueError(f"len(X) = {n}, but len({name}) = {v.shape[0]}")
             object.__setattr__(self, name, v)
         if self.fold_angles_deg.shape[0] != n:
-            raise ValueError(f"len(X) = {n}, but len(fold_angles_deg) = {len(self.fold_angles_deg)}")
+            m = len(self.fold_angles_deg)
+            raise ValueError(f"len(X) = {n}, but len(fold_angles_deg) = {m}")
         if self.reactions is not None:
             object.__setattr__(self, "reactions", np.asarray(self.reactions, float))
         object.__setattr__(

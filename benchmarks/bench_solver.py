@@ -76,8 +76,8 @@ def table_scaling(sizes: list[int], steps: int) -> None:
         "assembly",
         "factor",
         "schur",
-        "bare LU s",
-        "iter/LU",
+        "bare factor s",
+        "iter/factor",
     )
     print("| " + " | ".join(cols) + " |")
     print("|" + "---|" * len(cols))

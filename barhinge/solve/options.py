@@ -48,9 +48,10 @@ class SolverOptions:
         bordered actuator system (exact: the term is compensated on the right-hand side).
         ``"auto"`` scales it to the tangent; 0 disables it.
     predictor : str
-        ``"secant"`` (extrapolate the last two converged states; tangent step for the first
-        increment), ``"quadratic"`` (through the last three) or ``"tangent"`` (always a
-        linearised step at the last converged state).
+        ``"secant"`` (default: extrapolate the last two converged states; tangent step for the
+        first increment), ``"quadratic"`` (through the last three: fewer iterations on smooth
+        paths, less robust near instabilities) or ``"tangent"`` (always a linearised step at
+        the last converged state).
     line_search : int
         Maximum halvings of a Newton correction in the backtracking line search on
         ``|r|^2 + (s c)^2`` (0 = plain Newton, the default: on stiff-bar / soft-fold
@@ -71,7 +72,7 @@ class SolverOptions:
     divergence_ratio: float = 1e4
     linear_solver: str = "auto"
     augmentation: float | str = "auto"
-    predictor: str = "quadratic"
+    predictor: str = "secant"
     line_search: int = 0
     arc_length_increment: float | None = None
     max_arc_steps: int | None = None
