@@ -126,7 +126,9 @@ def results_rows(out_dir: str | Path, name: str = "fold_path") -> list[tuple[str
     add("max |angle defect| (deg)", "max_abs_angle_defect_deg", "{:.3g}")
     add("max |bar strain|", "max_abs_bar_strain", "{:.3g}")
     if s.get("lowest_eigenvalues"):
-        rows.append(("lowest stiffness eigenvalue", f"{s['lowest_eigenvalues'][0]:.4g}"))
+        rows.append(
+            ("lowest tangent eigenvalue (actuators released)", f"{s['lowest_eigenvalues'][0]:.4g}")
+        )
     add("soft modes (of those computed)", "n_soft_modes", "{}")
     add("effective stiffness (scene loads)", "effective_stiffness")
     return rows
