@@ -97,6 +97,7 @@ class _Driver:
         self._last_sub: dict[str, Any] | None = None
         self._prev: _State | None = None
         self._prev2: _State | None = None
+        self._retry_tangent = False  # next increment: tangent predictor (after a failure)
         self._samples: list[tuple[float, np.ndarray, np.ndarray]] = []
         self.c_scale = 1.0
         self.n_fact_last = 0
@@ -172,6 +173,12 @@ class _Driver:
         ok_x = float(np.linalg.norm(dx)) <= o.tol_disp * self.size
         if not ok_x and len(res) >= 2 and rf < 1e-3 * res[-2]:
             ok_x = True
+        if not ok_x and ok_f and len(res) >= 2 and rf <= 0.5 * res[-2]:
+            # contracting iteration (ratio q): the remaining error is at most about
+            # |dx| q / (1 - q) (linear rate; less in the quadratic regime). Saves the
+            # confirming iterations at the round-off floor of the force residual.
+            q = rf / res[-2]
+            ok_x = float(np.linalg.norm(dx)) * q / (1 - q) <= o.tol_disp * self.size
         ok_c = (not self.n_act) or float(np.max(np.abs(e.c))) <= o.tol_angle
         return ok_f and ok_x and ok_c
 
@@ -191,7 +198,8 @@ class _Driver:
         self.system.inertia_seen = []
         prev = self._prev
         prev2 = self._prev2
-        if prev is not None and prev.t < st.t and o.predictor in ("secant", "quadratic"):
+        extrapolate = o.predictor in ("secant", "quadratic") and not self._retry_tangent
+        if prev is not None and prev.t < st.t and extrapolate:
             if o.predictor == "quadratic" and prev2 is not None and prev2.t < prev.t:
                 # Lagrange extrapolation through the last three converged states
                 ta, tb, tc = prev2.t, prev.t, st.t
@@ -443,12 +451,24 @@ class _Driver:
                                 f"{self._inertia} to {bad[0]} while iterating ({f.why}); use "
                                 "control = 'arc_length' to pass it"
                             )
+                    if (
+                        not self._retry_tangent
+                        and self._prev is not None
+                        and (self.opts.predictor != "tangent")
+                    ):
+                        # an extrapolating predictor failed: retry the same increment once
+                        # with the tangent predictor before cutting back (near a soft mode
+                        # the extrapolated start can lie outside Newton's basin)
+                        self._retry_tangent = True
+                        continue
+                    self._retry_tangent = False
                     h = h_try / 2
                     if h < h_min * (1 - 1e-9):
                         # near a critical point the smallest increments may simply find no
                         # solution; name the critical point if one was detected on the way
                         raise self.fail(s, st.lam, critical or f.why, f.residuals) from None
                     continue
+                self._retry_tangent = False
                 self._work_simpson(new, e_new)
                 critical = ""
                 self._prev2, self._prev, st = self._prev, st, new
