@@ -412,6 +412,12 @@ def rigid_fold(
             rc, cp, act, sched, states, iters, hists, walls, False, msg, dofs, events, opt
         )
 
+    def failure(msg: str, s: int, hist: list[float]) -> ConvergenceError:
+        """The error for a failed step ``s`` (1-based), carrying the converged part."""
+        return ConvergenceError(
+            msg, step=s - 1, load_factor=(s - 1) / steps, residuals=hist, last_state=partial(msg)
+        )
+
     for s in range(1, steps + 1):
         solver.iterations = 0
         hist_all: list[float] = []
@@ -431,13 +437,7 @@ def rigid_fold(
                 f"step {s}: the Jacobian of the free creases is singular (a bifurcation "
                 f"point or actuators that leave free motions)"
             )
-            raise ConvergenceError(
-                msg,
-                step=s - 1,
-                load_factor=(s - 1) / steps,
-                residuals=hist_all,
-                last_state=partial(msg),
-            ) from None
+            raise failure(msg, s, hist_all) from None
         if not ok and over < 0 and np.max(np.abs(rho), initial=0.0) >= FLAT_TOL:
             # would the tangent towards the target carry a crease past +-180 deg?
             try:
@@ -474,13 +474,7 @@ def rigid_fold(
                     f"{hist_all[-1] if hist_all else float('nan'):.2e} > {opt.tol:.0e}) after "
                     f"{opt.max_cutbacks} cut-backs{hint}"
                 )
-            raise ConvergenceError(
-                msg,
-                step=s - 1,
-                load_factor=(s - 1) / steps,
-                residuals=hist_all,
-                last_state=partial(msg),
-            )
+            raise failure(msg, s, hist_all)
         rho = rho_new
         if np.max(np.abs(rho)) >= np.radians(opt.lock_deg):
             worst = int(np.argmax(np.abs(rho)))
