@@ -37,6 +37,7 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from barhinge.solve.linear import LinearBackend, SingularMatrixError
 
@@ -53,6 +54,7 @@ class Timer:
     other: float = 0.0
     n_factorizations: int = 0
     n_iterations: int = 0
+    n_krylov: int = 0
 
     def as_dict(self) -> dict[str, float]:
         return dataclasses.asdict(self)
@@ -103,8 +105,67 @@ def actuator_terms(model: Any, X: np.ndarray, hinge_ids: np.ndarray) -> Actuator
     return ActuatorTerms(rho, G, grad, hess, dofs)
 
 
+class _KrylovStalled(Exception):
+    """GMRES used up its iterations (raised from its callback)."""
+
+
+@dataclasses.dataclass
+class _DirectSolver:
+    """One factorisation of ``A = K_t + p G^T G`` and its Schur complement: solves the
+    bordered system of the state where it was factorised exactly."""
+
+    factor: Any
+    Gf: sp.csr_matrix | None  # (n_act, n_free) or None without actuators
+    Z: np.ndarray | None  # A^-1 G^T (None with a Cholesky half solve)
+    S_inv: np.ndarray | None  # (G A^-1 G^T)^-1
+    penalty: float
+
+    def solve(self, rhs_x: np.ndarray, rhs_c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if self.Gf is None:
+            dx = np.asarray(self.factor.solve(rhs_x))
+            return dx, np.zeros((0,) + np.shape(rhs_x)[1:])
+        # augmented first block row: rhs_x + p G^T rhs_c (compensates the p G^T G in A)
+        bx = rhs_x + self.penalty * (self.Gf.T @ rhs_c)
+        a0 = np.asarray(self.factor.solve(bx))
+        dmu = self.S_inv @ (self.Gf @ a0 - rhs_c)
+        if self.Z is not None:
+            dx = a0 - self.Z @ dmu
+        else:
+            dx = a0 - np.asarray(self.factor.solve(self.Gf.T @ dmu))
+        return dx, dmu
+
+
+@dataclasses.dataclass
+class _KKTSolver:
+    """A factorisation of the augmented bordered matrix ``[A G^T; G 0]`` itself."""
+
+    factor: Any
+    Gf: sp.csr_matrix
+    penalty: float
+
+    def solve(self, rhs_x: np.ndarray, rhs_c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        bx = rhs_x + self.penalty * (self.Gf.T @ rhs_c)
+        z = np.asarray(self.factor.solve(np.concatenate([bx, rhs_c])))
+        nf = len(rhs_x)
+        return z[:nf], z[nf:]
+
+
 class BorderedSystem:
     """Factorise and solve the (bordered) Newton system on the free DOFs.
+
+    Two modes:
+
+    * direct (``reuse=False``): every :meth:`set_operator` factorises; :meth:`solve` is
+      exact.
+    * factorisation reuse (``reuse=True``): :meth:`set_operator` only assembles the new
+      tangent; :meth:`solve` runs preconditioned GMRES (scipy) on the exact bordered system
+      of the new tangent, preconditioned by the last factorisation (an exact solve of a
+      nearby state's system). A new factorisation is made when GMRES does not reach its
+      tolerance within ``krylov_max`` iterations (then the solve is direct), or when the
+      GMRES time accumulated since the last factorisation exceeds that factorisation's
+      cost (then at the next :meth:`set_operator`). Newton keeps its quadratic rate when
+      the linear tolerance follows the residual (inexact Newton, Dembo, Eisenstat &
+      Steihaug 1982); the driver passes that tolerance.
 
     Parameters
     ----------
@@ -112,10 +173,20 @@ class BorderedSystem:
     free : (n_dof,) bool mask of the free DOFs.
     act_dofs : (n_act, 12) global DOFs of the actuator blocks (fixed for the whole solve).
     timer : Timer
+    reuse : bool
+        Factorisation reuse with GMRES (see above).
+    krylov_max : int
+        GMRES iterations before a fresh factorisation is made.
     """
 
     def __init__(
-        self, backend: LinearBackend, free: np.ndarray, act_dofs: np.ndarray, timer: Timer
+        self,
+        backend: LinearBackend,
+        free: np.ndarray,
+        act_dofs: np.ndarray,
+        timer: Timer,
+        reuse: bool = False,
+        krylov_max: int = 30,
     ) -> None:
         self.backend = backend
         self.free = np.asarray(free, bool)
@@ -123,19 +194,32 @@ class BorderedSystem:
         self.n_dof = len(self.free)
         self.act_dofs = act_dofs
         self.timer = timer
+        self.reuse = reuse
+        self.krylov_max = krylov_max
+        self.row_scale = 1.0  # scale of the constraint rows in the GMRES norm (force/rad)
         self._key: tuple | None = None
         self._sel: np.ndarray | None = None
         self._sub_indptr: np.ndarray | None = None
         self._sub_indices: np.ndarray | None = None
         self._blk_pos: np.ndarray | None = None  # positions of actuator blocks in K.data
         self._blk_ok = False
-        self.factor = None
+        self.factor: Any = None
         self.track_inertia = False
         self.negative_pivots: int | None = None
         self.inertia_seen: list[int | None] = []
+        # current operator (exact tangent of the current iterate)
+        self._data_full: np.ndarray | None = None  # K's values + actuator blocks
+        self._A: sp.csr_matrix | None = None
         self.Gf: sp.csr_matrix | None = None
-        self.Z: np.ndarray | None = None  # A^-1 G^T (None with a Cholesky half solve)
-        self.S_lu = None
+        self.penalty = 0.0
+        self.direct: _DirectSolver | _KKTSolver | None = None  # last factorisation
+        self.current_factored = False  # the last factorisation is of the current operator
+        self._fact_cost = 0.0  # seconds of the last factorisation (incl. Schur complement)
+        self._krylov_cost = 0.0  # GMRES seconds since the last factorisation
+        self.last_krylov_iters = 0
+        self._kkt_key: tuple | None = None
+        self._kkt_gather: np.ndarray | None = None
+        self._kkt_pattern: tuple | None = None
 
     # ---------------------------------------------------------------- structure
     def _prepare(self, K: sp.csr_matrix) -> None:
@@ -168,8 +252,8 @@ class BorderedSystem:
             self._blk_ok = True
             self._blk_pos = np.zeros(0, np.int64)
 
-    def _free_matrix(self, K: sp.csr_matrix, blocks: np.ndarray) -> sp.csr_matrix:
-        """K_ff plus the actuator blocks (n_act, 12, 12) scattered on their DOFs."""
+    def _free_data(self, K: sp.csr_matrix, blocks: np.ndarray) -> np.ndarray:
+        """Values of K (its CSR pattern) plus the actuator blocks (n_act, 12, 12)."""
         self._prepare(K)
         if len(blocks) and not self._blk_ok:
             # the model's pattern does not hold the blocks: add them as a sparse matrix
@@ -180,22 +264,38 @@ class BorderedSystem:
             K = (K + B).tocsr()
             self._key = None
             self._prepare(K)
-            data = K.data
-        elif len(blocks):
+            return K.data
+        if len(blocks):
             data = K.data.copy()
             np.add.at(data, self._blk_pos, blocks.ravel())
-        else:
-            data = K.data
-        nf = len(self.free_idx)
-        return sp.csr_matrix((data[self._sel], self._sub_indices, self._sub_indptr), shape=(nf, nf))
+            return data
+        return K.data
 
-    # ---------------------------------------------------------------- factorise
-    def factorize(
-        self, K: sp.csr_matrix, terms: ActuatorTerms, mu: np.ndarray, penalty: float
+    @property
+    def A(self) -> sp.csr_matrix | None:
+        """The current free-DOF operator ``K_ff + sum mu_a H_a + p G^T G`` (built on first
+        use: the saddle-point path gathers its matrix straight from K's values)."""
+        if self._A is None and self._data_full is not None:
+            nf = len(self.free_idx)
+            self._A = sp.csr_matrix(
+                (self._data_full[self._sel], self._sub_indices, self._sub_indptr), shape=(nf, nf)
+            )
+        return self._A
+
+    # ---------------------------------------------------------------- operator
+    def set_operator(
+        self,
+        K: sp.csr_matrix,
+        terms: ActuatorTerms,
+        mu: np.ndarray,
+        penalty: float,
+        factorize: bool = False,
     ) -> None:
-        """Factorise ``A = K_ff + sum mu_a H_a + p G^T G`` and the Schur complement.
+        """Make ``A = K_ff + sum mu_a H_a + p G^T G`` (and G) the current operator.
 
-        Raises SingularMatrixError when A or S is singular.
+        Factorises it in direct mode, when ``factorize`` is set, when there is no
+        factorisation yet, or when the reuse policy asks for a fresh one. Raises
+        SingularMatrixError when a factorisation finds A or the Schur complement singular.
         """
         na = len(mu)
         if na:
@@ -203,67 +303,209 @@ class BorderedSystem:
             blocks = mu[:, None, None] * terms.hess + penalty * g[:, :, None] * g[:, None, :]
         else:
             blocks = np.zeros((0, 12, 12))
-        A = self._free_matrix(K, blocks)
-        t0 = time.perf_counter()
-        self.factor = self.backend.factorize(A)
-        self.timer.factorize += time.perf_counter() - t0
+        self._data_full = self._free_data(K, blocks)
+        self._A = None
+        self.Gf = terms.G[:, self.free_idx].tocsr() if na else None
+        self.penalty = penalty
+        self.current_factored = False
+        stale = self._krylov_cost > self._fact_cost
+        if factorize or not self.reuse or self.direct is None or stale:
+            self._factorize_current()
+
+    def factorize(
+        self, K: sp.csr_matrix, terms: ActuatorTerms, mu: np.ndarray, penalty: float
+    ) -> None:
+        """Set the operator and factorise it (see :meth:`set_operator`)."""
+        self.set_operator(K, terms, mu, penalty, factorize=True)
+
+    def _kkt_matrix(self, upper: bool = False) -> sp.csr_matrix:
+        """The augmented bordered matrix ``[A G^T; G 0]`` (explicit zero diagonal kept),
+        or its upper triangle.
+
+        Its pattern is built once (entries tagged with their source position in K's values
+        or G's) and every later call is one gather from K's values and G's."""
+        G = self.Gf
+        na, nnz_k, nnz_g = G.shape[0], len(self._data_full), G.nnz
+        key = (self._key, upper, nnz_g, hash(G.indptr.tobytes()), hash(G.indices.tobytes()))
+        if key != self._kkt_key:
+            nf = len(self.free_idx)
+            tag_a = sp.csr_matrix(
+                (self._sel + 1.0, self._sub_indices, self._sub_indptr), shape=(nf, nf)
+            )
+            tag_g = sp.csr_matrix(
+                (np.arange(nnz_k + 1.0, nnz_k + nnz_g + 1), G.indices, G.indptr), G.shape
+            )
+            tag_0 = sp.csr_matrix(
+                (np.full(na, nnz_k + nnz_g + 1.0), (np.arange(na), np.arange(na))), (na, na)
+            )
+            tags = sp.bmat([[tag_a, tag_g.T], [tag_g, tag_0]], format="csr")
+            if upper:
+                tags = sp.triu(tags, format="csr")
+            tags.sort_indices()
+            self._kkt_gather = tags.data.astype(np.int64) - 1
+            self._kkt_pattern = (tags.indices, tags.indptr, tags.shape)
+            self._kkt_key = key
+        indices, indptr, shape = self._kkt_pattern
+        src = np.concatenate([self._data_full, G.data, [0.0]])
+        kkt = sp.csr_matrix((src[self._kkt_gather], indices, indptr), shape=shape)
+        kkt.has_sorted_indices = True
+        return kkt
+
+    def _factorize_current(self) -> None:
+        t_start = time.perf_counter()
+        if self.Gf is not None and getattr(self.backend, "saddle_point", False):
+            self._factorize_kkt(t_start)
+            return
+        self.factor = self.backend.factorize(self.A)
+        self.timer.factorize += time.perf_counter() - t_start
         self.timer.n_factorizations += 1
         if self.track_inertia:
             neg = getattr(self.factor, "negative_pivots", None)
             self.negative_pivots = neg() if neg is not None else None
             self.inertia_seen.append(self.negative_pivots)
-        self.penalty = penalty
-        if na:
+        Z = S_inv = None
+        if self.Gf is not None:
             t0 = time.perf_counter()
-            self.Gf = terms.G[:, self.free_idx].tocsr()
             half = getattr(self.factor, "half_solve", None)
             if half is not None:  # Cholesky: S = W^T W with W = L^-1 P G^T
                 W = half(self.Gf.T.toarray())
                 S = W.T @ W
-                self.Z = None
             else:
-                self.Z = np.asarray(self.factor.solve(self.Gf.T.toarray()))
-                if self.Z.ndim == 1:
-                    self.Z = self.Z[:, None]
-                S = self.Gf @ self.Z
+                Z = np.asarray(self.factor.solve(self.Gf.T.toarray()))
+                if Z.ndim == 1:
+                    Z = Z[:, None]
+                S = self.Gf @ Z
             S = 0.5 * (S + S.T)
             self.timer.solve += time.perf_counter() - t0
             try:
-                self.S_inv = np.linalg.inv(S)
+                S_inv = np.linalg.inv(S)
             except np.linalg.LinAlgError as exc:
                 raise SingularMatrixError(
                     "Schur complement G A^-1 G^T is singular: "
                     "actuators are redundant or fixed by supports"
                 ) from exc
-            if not np.all(np.isfinite(self.S_inv)) or np.linalg.cond(S) > 1e14:
+            if not np.all(np.isfinite(S_inv)) or np.linalg.cond(S) > 1e14:
                 raise SingularMatrixError(
                     "Schur complement G A^-1 G^T is singular: "
                     "actuators are redundant or fixed by supports"
                 )
-        else:
-            self.Gf = None
+        self.direct = _DirectSolver(self.factor, self.Gf, Z, S_inv, self.penalty)
+        self.current_factored = True
+        self._fact_cost = time.perf_counter() - t_start
+        self._krylov_cost = 0.0
 
-    def solve(self, rhs_x: np.ndarray, rhs_c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Solve ``[A_b G^T; G 0] [dx; dmu] = [rhs_x; rhs_c]`` (free DOFs; exact bordered
-        system, the augmentation being compensated here).
+    def _factorize_kkt(self, t_start: float) -> None:
+        """One symmetric indefinite factorisation of the whole bordered matrix (backends
+        with ``saddle_point``): no Schur complement, no ``n_act`` solves per iteration."""
+        na = self.Gf.shape[0]
+        self.factor = self.backend.factorize(self._kkt_matrix(upper=True), upper=True)
+        self.timer.factorize += time.perf_counter() - t_start
+        self.timer.n_factorizations += 1
+        if self.track_inertia:
+            # inertia(KKT) = inertia(A) + inertia(-S); S = G A^-1 G^T > 0 when A > 0
+            neg = getattr(self.factor, "negative_pivots", None)
+            self.negative_pivots = neg() - na if neg is not None else None
+            self.inertia_seen.append(self.negative_pivots)
+        self.direct = _KKTSolver(self.factor, self.Gf, self.penalty)
+        self.current_factored = True
+        self._fact_cost = time.perf_counter() - t_start
+        self._krylov_cost = 0.0
+
+    # ---------------------------------------------------------------- solve
+    def solve(
+        self, rhs_x: np.ndarray, rhs_c: np.ndarray, rtol: float = 1e-10
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Solve the exact bordered system ``[K_t G^T; G 0] [dx; dmu] = [rhs_x; rhs_c]`` of
+        the current operator (free DOFs).
 
         rhs_x : (n_free,) or (n_free, k); rhs_c : (n_act,) or (n_act, k).
+        rtol : relative tolerance of GMRES on the scaled residual (reuse mode only; the
+            solve is exact up to round-off when the current operator is factorised).
         """
         t0 = time.perf_counter()
-        if self.Gf is None:
-            dx = np.asarray(self.factor.solve(rhs_x))
+        self.last_krylov_iters = 0
+        if self.current_factored:
+            out = self.direct.solve(rhs_x, rhs_c)
             self.timer.solve += time.perf_counter() - t0
-            return dx, np.zeros((0,) + np.shape(rhs_x)[1:])
-        # augmented first block row: rhs_x + p G^T rhs_c
-        bx = rhs_x + self.penalty * (self.Gf.T @ rhs_c)
-        a0 = np.asarray(self.factor.solve(bx))
-        dmu = self.S_inv @ (self.Gf @ a0 - rhs_c)
-        if self.Z is not None:
-            dx = a0 - self.Z @ dmu
+            return out
+        if np.ndim(rhs_x) == 2:
+            cols = [self.solve(rhs_x[:, j], rhs_c[:, j], rtol) for j in range(rhs_x.shape[1])]
+            return np.stack([c[0] for c in cols], 1), np.stack([c[1] for c in cols], 1)
+        out = self._krylov(rhs_x, rhs_c, rtol)
+        dt = time.perf_counter() - t0
+        self.timer.solve += dt
+        if out is None:  # GMRES did not reach rtol: factorise this operator, solve directly
+            self._factorize_current()
+            t1 = time.perf_counter()
+            out = self.direct.solve(rhs_x, rhs_c)
+            self.timer.solve += time.perf_counter() - t1
         else:
-            dx = a0 - np.asarray(self.factor.solve(self.Gf.T @ dmu))
-        self.timer.solve += time.perf_counter() - t0
-        return dx, dmu
+            self._krylov_cost += dt
+        return out
+
+    def _krylov(
+        self, rhs_x: np.ndarray, rhs_c: np.ndarray, rtol: float
+    ) -> tuple[np.ndarray, np.ndarray] | None:
+        """GMRES on the scaled bordered system, preconditioned by the last factorisation.
+
+        Unknowns ``(dx, w = dmu / s)``, rows ``(forces, s * constraints)`` with ``s`` =
+        :attr:`row_scale`, so that every entry of the residual is a force."""
+        nf = self.A.shape[0]
+        A, G, p = self.A, self.Gf, self.penalty
+        s = self.row_scale
+        pre = self.direct
+        na = 0 if G is None else G.shape[0]
+
+        def matvec(z: np.ndarray) -> np.ndarray:
+            dx = z[:nf]
+            if not na:
+                return A @ dx
+            w = z[nf:]
+            gdx = G @ dx
+            # K_t dx = A dx - p G^T G dx (the current operator is augmented)
+            top = A @ dx - p * (G.T @ gdx) + s * (G.T @ w)
+            return np.concatenate([top, s * gdx])
+
+        def psolve(v: np.ndarray) -> np.ndarray:
+            if not na:
+                return np.asarray(pre.solve(v, np.zeros(0))[0])
+            dx, dmu = pre.solve(v[:nf], v[nf:] / s)
+            return np.concatenate([dx, dmu / s])
+
+        n = nf + na
+        op = spla.LinearOperator((n, n), matvec=matvec, dtype=float)
+        M = spla.LinearOperator((n, n), matvec=psolve, dtype=float)
+        b = np.concatenate([rhs_x, s * rhs_c]) if na else np.asarray(rhs_x, float)
+        if not np.any(b):
+            return np.zeros(nf), np.zeros(na)
+        count = [0]
+
+        def cb(_r: float) -> None:
+            count[0] += 1
+            if count[0] > self.krylov_max:
+                raise _KrylovStalled
+
+        try:
+            # restarts re-check the true residual (scipy's inner test is on the
+            # preconditioned one); the callback caps the total of inner iterations
+            z, info = spla.gmres(
+                op,
+                b,
+                rtol=rtol,
+                atol=0.0,
+                restart=self.krylov_max,
+                maxiter=self.krylov_max,
+                M=M,
+                callback=cb,
+                callback_type="pr_norm",
+            )
+        except _KrylovStalled:
+            z, info = None, -1
+        self.last_krylov_iters = count[0]
+        self.timer.n_krylov += count[0]
+        if info != 0 or z is None or not np.all(np.isfinite(z)):
+            return None
+        return z[:nf], s * z[nf:]
 
 
 def _csr_positions(K: sp.csr_matrix, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:

@@ -48,14 +48,27 @@ class SolverOptions:
         bordered actuator system (exact: the term is compensated on the right-hand side).
         ``"auto"`` scales it to the tangent; 0 disables it.
     predictor : str
-        ``"secant"`` (default: extrapolate the last two converged states; tangent step for the
-        first increment), ``"quadratic"`` (through the last three: fewer iterations on smooth
-        paths, less robust near instabilities) or ``"tangent"`` (always a linearised step at
-        the last converged state).
+        ``"quadratic"`` (default: Lagrange extrapolation through the last three converged
+        states; secant with two, tangent step for the first increment), ``"secant"``
+        (through the last two) or ``"tangent"`` (always a linearised step at the last
+        converged state). An increment whose extrapolated start fails is retried once with
+        the tangent predictor before it is cut back. On the Miura actuator benchmark the
+        quadratic predictor needs 2 corrections per step where the secant needs 3
+        (docs/solver-performance.md).
     line_search : int
         Maximum halvings of a Newton correction in the backtracking line search on
         ``|r|^2 + (s c)^2`` (0 = plain Newton, the default: on stiff-bar / soft-fold
         mechanisms full Newton steps with cut-back of the increment were measured faster).
+    reuse_factorization : bool
+        Reuse a factorisation over Newton iterations and increments as the preconditioner
+        of GMRES on the exact tangent system (a fresh factorisation when GMRES stalls or has
+        cost more than one factorisation): the same converged states with fewer
+        factorisations. Off by default: on the Miura benchmarks the tangent changes too much
+        between iterates (bar forces of the predictor) and GMRES needs 10-30 iterations, so
+        it was measured slower than factorising (docs/solver-performance.md). Worth trying
+        with many small increments and a slow factorisation. Not used under arc length.
+    krylov_max : int
+        GMRES iterations per solve before a fresh factorisation is made instead.
     arc_length_increment : float or None
         Load-factor increment of the first arc-length (MGDCM) step; default ``1/steps``.
     max_arc_steps : int or None
@@ -72,8 +85,10 @@ class SolverOptions:
     divergence_ratio: float = 1e4
     linear_solver: str = "auto"
     augmentation: float | str = "auto"
-    predictor: str = "secant"
+    predictor: str = "quadratic"
     line_search: int = 0
+    reuse_factorization: bool = False
+    krylov_max: int = 30
     arc_length_increment: float | None = None
     max_arc_steps: int | None = None
 
@@ -82,7 +97,7 @@ class SolverOptions:
             v = getattr(self, name)
             if not (isinstance(v, int | float) and v > 0):
                 raise ConfigError(f"solver option {name} = {v!r}; expected a positive number")
-        for name in ("max_iter", "grow_iters"):
+        for name in ("max_iter", "grow_iters", "krylov_max"):
             v = getattr(self, name)
             if not (isinstance(v, int) and v >= 1):
                 raise ConfigError(f"solver option {name} = {v!r}; expected an integer >= 1")
@@ -95,9 +110,18 @@ class SolverOptions:
             )
         if not (isinstance(self.line_search, int) and self.line_search >= 0):
             raise ConfigError(f"solver option line_search = {self.line_search!r}; expected >= 0")
+        if not isinstance(self.reuse_factorization, bool):
+            raise ConfigError(
+                f"solver option reuse_factorization = {self.reuse_factorization!r}; "
+                "expected true or false"
+            )
         a = self.augmentation
         if not (a == "auto" or (isinstance(a, int | float) and a >= 0)):
             raise ConfigError(f"solver option augmentation = {a!r}; expected 'auto' or >= 0")
+
+    def reuses_factorization(self, control: str) -> bool:
+        """Whether the solve under ``control`` reuses factorisations (see the option)."""
+        return bool(self.reuse_factorization) and control != "arc_length"
 
     @classmethod
     def from_dict(cls, d: dict[str, Any] | None) -> SolverOptions:
