@@ -25,8 +25,10 @@ augmented-Lagrangian form ``A = K_t + p G^T G`` with the right-hand side
 ``-(r + p G^T c)``: adding ``p G^T`` times the second block row to the first gives an
 *equivalent* system, so the solution is exactly the one of the bordered system, and ``A`` is
 nonsingular whenever the bordered system is (for a large enough ``p`` on the constrained
-directions). It is solved through one factorisation of ``A`` and the small dense Schur
-complement ``S = G A^-1 G^T`` (n_act x n_act).
+directions). Backends that factorise symmetric indefinite matrices (PARDISO) factorise the
+whole bordered matrix ``[A G^T; G 0]`` once; the others factorise ``A`` and form the small
+dense Schur complement ``S = G A^-1 G^T`` (n_act x n_act). Optionally a factorisation is
+reused as the preconditioner of GMRES on later tangents (:class:`BorderedSystem`).
 """
 
 from __future__ import annotations
@@ -55,6 +57,7 @@ class Timer:
     n_factorizations: int = 0
     n_iterations: int = 0
     n_krylov: int = 0
+    n_force_only: int = 0  # evaluations without the tangent (convergence expected)
 
     def as_dict(self) -> dict[str, float]:
         return dataclasses.asdict(self)
@@ -198,6 +201,7 @@ class BorderedSystem:
         self.krylov_max = krylov_max
         self.row_scale = 1.0  # scale of the constraint rows in the GMRES norm (force/rad)
         self._key: tuple | None = None
+        self._pattern_arrays: tuple = (None, None)
         self._sel: np.ndarray | None = None
         self._sub_indptr: np.ndarray | None = None
         self._sub_indices: np.ndarray | None = None
@@ -225,7 +229,10 @@ class BorderedSystem:
     def _prepare(self, K: sp.csr_matrix) -> None:
         """Scatter maps from K's CSR pattern to the free-free submatrix, built once."""
         K.sort_indices()
+        if K.indices is self._pattern_arrays[0] and K.indptr is self._pattern_arrays[1]:
+            return  # the assembler's own pattern arrays again (held here: ids stay unique)
         key = (K.shape, K.nnz, hash(K.indptr.tobytes()), hash(K.indices[::97].tobytes()))
+        self._pattern_arrays = (K.indices, K.indptr)
         if key == self._key:
             return
         self._key = key
@@ -354,8 +361,12 @@ class BorderedSystem:
     def _factorize_current(self) -> None:
         t_start = time.perf_counter()
         if self.Gf is not None and getattr(self.backend, "saddle_point", False):
-            self._factorize_kkt(t_start)
-            return
+            if self._factorize_kkt(t_start):
+                return
+            # perturbed pivots: the bordered matrix is (nearly) singular. Factorise A and the
+            # Schur complement instead, which names the cause (redundant actuators) or, if
+            # only the bordered pivoting struggled, solves exactly.
+            t_start = time.perf_counter()
         self.factor = self.backend.factorize(self.A)
         self.timer.factorize += time.perf_counter() - t_start
         self.timer.n_factorizations += 1
@@ -394,13 +405,17 @@ class BorderedSystem:
         self._fact_cost = time.perf_counter() - t_start
         self._krylov_cost = 0.0
 
-    def _factorize_kkt(self, t_start: float) -> None:
+    def _factorize_kkt(self, t_start: float) -> bool:
         """One symmetric indefinite factorisation of the whole bordered matrix (backends
-        with ``saddle_point``): no Schur complement, no ``n_act`` solves per iteration."""
+        with ``saddle_point``): no Schur complement, no ``n_act`` solves per iteration.
+        Returns False (nothing kept) when the factorisation had to perturb pivots."""
         na = self.Gf.shape[0]
         self.factor = self.backend.factorize(self._kkt_matrix(upper=True), upper=True)
         self.timer.factorize += time.perf_counter() - t_start
         self.timer.n_factorizations += 1
+        perturbed = getattr(self.factor, "perturbed_pivots", None)
+        if perturbed is not None and perturbed() > 0:
+            return False
         if self.track_inertia:
             # inertia(KKT) = inertia(A) + inertia(-S); S = G A^-1 G^T > 0 when A > 0
             neg = getattr(self.factor, "negative_pivots", None)
@@ -410,6 +425,7 @@ class BorderedSystem:
         self.current_factored = True
         self._fact_cost = time.perf_counter() - t_start
         self._krylov_cost = 0.0
+        return True
 
     # ---------------------------------------------------------------- solve
     def solve(

@@ -195,6 +195,12 @@ class _PardisoFactor:
         self._generation = generation
         iparm = backend._solver.iparm
         self._negative = int(iparm[22])  # iparm(23): negative eigenvalues (symmetric modes)
+        self._perturbed = int(iparm[13])  # iparm(14): pivots perturbed (singular to 1e-8)
+
+    def perturbed_pivots(self) -> int:
+        """Pivots PARDISO had to perturb: nonzero means A is singular or nearly so to working
+        precision, and solves are only approximate."""
+        return self._perturbed
 
     def negative_pivots(self) -> int:
         """Number of negative eigenvalues of A (PARDISO's inertia, iparm(23))."""
@@ -251,6 +257,7 @@ class PardisoBackend:
         self._upper_key: tuple | None = None
         self._upper_map: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._generation = 0
+        self._fallback = SuperLUBackend()
 
     def _upper(self, A: sp.spmatrix) -> sp.csr_matrix:
         """Upper triangle of A in CSR (explicit zeros kept), through a map built once per
@@ -278,7 +285,9 @@ class PardisoBackend:
 
     def factorize(self, A: sp.spmatrix, upper: bool = False) -> Factor:
         """Factorise the symmetric matrix A (``upper``: A is already its upper triangle in
-        CSR with sorted indices and every diagonal entry stored)."""
+        CSR with sorted indices and every diagonal entry stored; the caller then checks
+        ``perturbed_pivots``). A full matrix whose factorisation needed perturbed pivots is
+        handed to SuperLU instead (exact, or SingularMatrixError)."""
         if upper:
             U = A
             sample = U.indices[:: max(1, U.nnz // 997)]
@@ -299,7 +308,13 @@ class PardisoBackend:
             self._key = None
             raise SingularMatrixError(f"PARDISO: {exc}") from exc
         self._generation += 1
-        return _PardisoFactor(self, U, self._generation)
+        factor = _PardisoFactor(self, U, self._generation)
+        if not upper and factor.perturbed_pivots() > 0:
+            # nearly singular to working precision: PARDISO's solves would be approximate.
+            # SuperLU's exact LU of this matrix either solves it or says it is singular.
+            log.debug("PARDISO perturbed %d pivots; SuperLU for this matrix", factor._perturbed)
+            return self._fallback.factorize(A)
+        return factor
 
 
 BACKENDS: dict[str, tuple[str | None, Callable[[], LinearBackend]]] = {

@@ -108,6 +108,7 @@ class _Driver:
         self._samples: list[tuple[float, np.ndarray, np.ndarray]] = []
         self.c_scale = 1.0
         self.n_iter_last = 0  # Newton corrections of the last converged increment
+        self._tol_abs: float | None = None  # absolute force tolerance at the last test
         self._inertia: int | None = None
         self.system.track_inertia = scene.control in ("load", "displacement")
         # what a change of the free-DOF tangent's inertia means under this control: a load
@@ -128,10 +129,13 @@ class _Driver:
         return self.X0.ravel()[self.fixed] + t * self.u_pres[self.fixed]
 
     # ------------------------------------------------------------ evaluation
-    def evaluate(self, st: _State) -> _Eval:
+    def evaluate(self, st: _State, tangent: bool = True) -> _Eval:
+        """Residual, constraints and (unless ``tangent`` is False) the tangent at ``st``."""
         t0 = time.perf_counter()
         X = st.x.reshape(-1, 3)
-        ev = self.model.evaluate(X, tangent=True)
+        tangent = tangent or self.force_floor is None or self.penalty is None
+        ev = self.model.evaluate(X, tangent=tangent)
+        self.timer.n_force_only += not tangent
         terms = actuator_terms(self.model, X, self.hinges)
         self.timer.assembly += time.perf_counter() - t0
         r = np.asarray(ev.force, float).ravel() - st.lam * self.P
@@ -196,7 +200,8 @@ class _Driver:
     def converged(self, e: _Eval, st: _State, dx: np.ndarray, res: list[float]) -> bool:
         o = self.opts
         rf = float(np.linalg.norm(e.r[self.free]))
-        ok_f = rf <= o.tol_force * self.force_ref(e, st) + self.force_floor
+        self._tol_abs = o.tol_force * self.force_ref(e, st) + self.force_floor
+        ok_f = rf <= self._tol_abs
         ok_x = float(np.linalg.norm(dx)) <= o.tol_disp * self.size
         if not ok_x and len(res) >= 2 and rf < 1e-3 * res[-2]:
             ok_x = True
@@ -213,11 +218,12 @@ class _Driver:
     def increment(self, st: _State, t1: float, lam1: float) -> tuple[_State, _Eval, list[float]]:
         """Newton from the converged state ``st`` to path parameter t1 (load factor lam1).
 
-        Predictor: secant extrapolation of the last two converged states when there are two
-        (second-order accurate along a smoothly curving fold path), otherwise a tangent step
-        at ``st`` with the prescribed displacements and new targets linearised. Correctors:
-        Newton with the analytic tangent and a backtracking line search on the merit
-        ``|r_free|^2 + (s c)^2`` (full steps near the solution, so the rate stays quadratic).
+        Predictor (option ``predictor``): extrapolation through the last three (quadratic)
+        or two (secant) converged states, otherwise a tangent step at ``st`` with the
+        prescribed displacements and new targets linearised. Correctors: Newton with the
+        analytic tangent and an optional backtracking line search on the merit
+        ``|r_free|^2 + (s c)^2``. An iterate expected to pass the force test is evaluated
+        without the tangent first (assembled afterwards if it does not pass).
         """
         o = self.opts
         free, fixed = self.free, self.fixed
@@ -273,10 +279,12 @@ class _Driver:
                 raise _Failed(f"no convergence in {o.max_iter} iterations", res)
             if len(res) > 2 and rf > o.divergence_ratio * max(res[0], self.force_floor):
                 raise _Failed("residual diverged", res)
+            if e.ev.K is None:  # evaluated without tangent (convergence was expected)
+                e = self.evaluate(new)
             self._factorize_or_fail(e, new, res, reuse=n_iter > 0)
             n_iter += 1
             dx, dmu = self.system.solve(-e.r[free], -e.c, rtol=self.forcing(e, new, rf))
-            new, e, alpha = self._line_search(new, e, dx, dmu)
+            new, e, alpha = self._line_search(new, e, dx, dmu, self._expects_convergence(res))
             dx_last = alpha * dx
 
     def _check_inertia(self, res: list[float]) -> None:
@@ -320,14 +328,26 @@ class _Driver:
             (self.c_scale * e.c) @ e.c * self.c_scale
         )
 
-    def _line_search(self, st: _State, e: _Eval, dx: np.ndarray, dmu: np.ndarray):
-        """Backtracking (Armijo) on the merit function; the trial evaluation is reused."""
+    def _expects_convergence(self, res: list[float]) -> bool:
+        """Whether the next iterate will probably pass the force test: in the quadratic
+        regime ``r_{k+1} ~ r_k^3 / r_{k-1}^2``. Then it is evaluated without the tangent
+        (a quarter of the cost; the tangent follows if the guess was wrong)."""
+        if len(res) < 2 or not res[-2] > 0 or self._tol_abs is None:
+            return False
+        q = res[-1] / res[-2]
+        return q < 0.1 and res[-1] * q * q <= 0.5 * self._tol_abs
+
+    def _line_search(
+        self, st: _State, e: _Eval, dx: np.ndarray, dmu: np.ndarray, light: bool = False
+    ):
+        """Backtracking (Armijo) on the merit function; the trial evaluation is reused
+        (``light``: the full step is evaluated without the tangent)."""
         phi0 = self._merit(e)
         alpha = 1.0
         for k in range(self.opts.line_search + 1):
             trial = _State(st.x.copy(), st.mu + alpha * dmu, st.lam, st.t)
             trial.x[self.free] += alpha * dx
-            et = self.evaluate(trial)
+            et = self.evaluate(trial, tangent=not (light and k == 0))
             phi = self._merit(et)
             if (
                 np.isfinite(phi) and phi <= (1 - 1e-4 * alpha) * phi0

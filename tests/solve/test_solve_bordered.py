@@ -144,3 +144,45 @@ def test_kkt_matrix_keeps_its_pattern_and_zero_diagonal():
     kkt2 = sysm._kkt_matrix()
     assert kkt2.nnz == kkt.nnz and np.all(kkt2.indices == kkt.indices)
     assert sp.issparse(kkt2)
+
+
+def test_force_only_evaluation_when_convergence_is_expected_changes_nothing(monkeypatch):
+    """Iterates expected to converge are evaluated without the tangent (assembled later
+    only if the guess was wrong). The path must be identical, bit for bit, to the one with
+    the tangent assembled at every iterate."""
+    from barhinge.solve import newton
+
+    cp = bh.patterns.miura(3, 3, alpha=60.0, fold=10.0)
+    cp1 = bh.patterns.miura(3, 3, alpha=60.0, fold=40.0)
+    model = BarHingeModel.from_pattern(cp, "N5B8", fold_stiffness=0.1, bar_EA=1e4)
+    edges = miura_line_creases(cp)
+    acts = bh.Actuators(edges=edges, targets_deg=np.asarray(cp1.fold_angles)[edges])
+    scene = Scene(model, actuators=acts, steps=6)
+    light = bh.solve(scene)
+    assert light.meta["timing"]["n_force_only"] > 0
+    monkeypatch.setattr(newton._Driver, "_expects_convergence", lambda self, res: False)
+    full = bh.solve(scene)
+    assert full.meta["timing"]["n_force_only"] == 0
+    np.testing.assert_array_equal(light.X, full.X)
+    np.testing.assert_array_equal(light.actuator_moments, full.actuator_moments)
+    assert light.residual_norms == full.residual_norms
+
+
+@pytest.mark.parametrize("name", available_backends())
+def test_redundant_actuators_are_named_by_every_backend(name):
+    """Every crease of a flat waterbomb actuated: the actuator rows are dependent at the
+    flat state (documented in docs/roofs.md). Each backend must stop with the cause named;
+    PARDISO's bordered factorisation perturbs pivots there and falls back to the Schur
+    complement, which identifies the redundancy."""
+    cp = bh.patterns.waterbomb(2, 2)
+    model = BarHingeModel.from_pattern(cp, "N5B8", fold_stiffness=0.1, bar_EA=1e4)
+    edges = np.flatnonzero(np.isin(np.asarray(cp.assignment), ["M", "V"]))
+    targets = 0.2 * np.asarray(cp.fold_angles)[edges]
+    scene = Scene(
+        model,
+        actuators=bh.Actuators(edges=edges, targets_deg=targets),
+        steps=3,
+        options={"linear_solver": name, "max_cutbacks": 1},
+    )
+    with pytest.raises(bh.ConvergenceError, match="actuators are redundant"):
+        bh.solve(scene)

@@ -124,3 +124,12 @@ def test_pardiso_rejects_a_missing_diagonal_and_singular():
     M = sp.csr_matrix(np.array([[0.0, 1.0], [1.0, 0.0]]))  # no stored diagonal
     with pytest.raises(SingularMatrixError, match="diagonal"):
         get_backend("pardiso").factorize(M)
+    # singular (a stored zero pivot): PARDISO would perturb it and solve approximately; the
+    # backend hands such a matrix to SuperLU, which says it is singular
+    S = sp.csr_matrix(
+        (np.array([2.0, 1.0, 1.0, 1.0, 0.0]), np.array([0, 1, 0, 1, 2]), np.array([0, 2, 4, 5])),
+        shape=(3, 3),
+    )
+    assert S.nnz == 5 and S.diagonal()[2] == 0.0
+    with pytest.raises(SingularMatrixError):
+        get_backend("pardiso").factorize(S)
