@@ -80,7 +80,7 @@ def miura_scene(
 
 
 def bare_factorisation(
-    scene: Scene, X: np.ndarray, backend: str, repeat: int = 5
+    scene: Scene, X: np.ndarray, mu: np.ndarray, backend: str, repeat: int = 5
 ) -> tuple[float, float]:
     """Median times of one factorisation of the matrix the solver factorises at ``X``
     (the bordered matrix for PARDISO, ``K_ff + p G^T G`` for the Schur-complement
@@ -90,10 +90,13 @@ def bare_factorisation(
     K = model.evaluate(X).K
     free = ~scene.fixed.ravel()
     T = actuator_terms(model, X, scene.actuator_hinges())
-    p = float(np.mean(np.abs(K.diagonal()))) / float(np.mean(np.sum(T.grad**2, axis=1)))
+    # the solver's own augmentation ("auto": mean diagonal on the actuator DOFs over the
+    # mean |grad rho|^2) and multipliers: the very matrix of its last iteration
+    kd = float(np.mean(np.abs(K.diagonal())[T.dofs.ravel()]))
+    p = kd / float(np.mean(np.sum(T.grad**2, axis=1)))
     b = get_backend(backend)
     sysm = BorderedSystem(b, free, T.dofs, Timer())
-    sysm.set_operator(K, T, np.zeros(len(T.rho)), p)  # factorises once (warm-up)
+    sysm.set_operator(K, T, mu, p)  # factorises once (warm-up)
     saddle = getattr(b, "saddle_point", False)
     A = sysm._kkt_matrix(upper=True) if saddle else sysm.A
     kw = {"upper": True} if saddle else {}
@@ -149,7 +152,8 @@ def table_scaling(sizes: list[int], steps: int, linear_solver: str) -> None:
         # Newton correction is one factorisation (extrapolating predictor, no reuse)
         its = path.iterations[2:].sum()
         per_iter = (path.wall_time[-1] - path.wall_time[1]) / its if its else wall / nf
-        refac, full = bare_factorisation(sc, path.X[-1], path.meta["linear_solver"])
+        mu = -path.actuator_moments[-1]  # multipliers of the last state
+        refac, full = bare_factorisation(sc, path.X[-1], mu, path.meta["linear_solver"])
         row = (
             n,
             sc.model.n_dof,

@@ -223,6 +223,7 @@ class BorderedSystem:
         self.last_krylov_iters = 0
         self._kkt_key: tuple | None = None
         self._kkt_gather: np.ndarray | None = None
+        self._kkt_g: tuple[np.ndarray, np.ndarray] | None = None
         self._kkt_pattern: tuple | None = None
 
     # ---------------------------------------------------------------- structure
@@ -349,12 +350,19 @@ class BorderedSystem:
             if upper:
                 tags = sp.triu(tags, format="csr")
             tags.sort_indices()
-            self._kkt_gather = tags.data.astype(np.int64) - 1
+            src = tags.data.astype(np.int64) - 1
+            from_k = src < nnz_k
+            # one take from K's values (the few G and zero entries read position 0 and are
+            # overwritten): no copy of K's values into a concatenated source
+            self._kkt_gather = np.where(from_k, src, 0)
+            self._kkt_g = (np.flatnonzero(~from_k), src[~from_k] - nnz_k)  # G, then the zero
             self._kkt_pattern = (tags.indices, tags.indptr, tags.shape)
             self._kkt_key = key
         indices, indptr, shape = self._kkt_pattern
-        src = np.concatenate([self._data_full, G.data, [0.0]])
-        kkt = sp.csr_matrix((src[self._kkt_gather], indices, indptr), shape=shape)
+        data = self._data_full.take(self._kkt_gather)
+        pos, idx = self._kkt_g
+        data[pos] = np.append(G.data, 0.0)[idx]
+        kkt = sp.csr_matrix((data, indices, indptr), shape=shape)
         kkt.has_sorted_indices = True
         return kkt
 
