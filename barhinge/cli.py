@@ -503,6 +503,7 @@ def fold_cmd(
     t.add_row("states", str(info["n_states"]))
     t.add_row("Newton iterations", str(info["newton_iterations"]))
     t.add_row("wall time (s)", f"{info['wall_time_s']:.2f}")
+    t.add_row("linear solver", str(info.get("linear_solver")))
     for k, v in info["energy"].items():
         t.add_row(f"energy {k}", f"{v:.6g}")
     if info["actuators"]["moment"]:
