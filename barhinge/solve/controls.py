@@ -378,10 +378,7 @@ class BorderedSystem:
         self.factor = self.backend.factorize(self.A)
         self.timer.factorize += time.perf_counter() - t_start
         self.timer.n_factorizations += 1
-        if self.track_inertia:
-            neg = getattr(self.factor, "negative_pivots", None)
-            self.negative_pivots = neg() if neg is not None else None
-            self.inertia_seen.append(self.negative_pivots)
+        self._record_inertia(0)
         Z = S_inv = None
         if self.Gf is not None:
             t0 = time.perf_counter()
@@ -397,18 +394,27 @@ class BorderedSystem:
             S = 0.5 * (S + S.T)
             self.timer.solve += time.perf_counter() - t0
             try:
-                S_inv = np.linalg.inv(S)
-            except np.linalg.LinAlgError as exc:
-                raise SingularMatrixError(
-                    "Schur complement G A^-1 G^T is singular: "
-                    "actuators are redundant or fixed by supports"
-                ) from exc
-            if not np.all(np.isfinite(S_inv)) or np.linalg.cond(S) > 1e14:
+                S_inv = np.linalg.inv(S) if np.linalg.cond(S) <= 1e14 else None
+            except np.linalg.LinAlgError:
+                S_inv = None
+            if S_inv is None or not np.all(np.isfinite(S_inv)):
                 raise SingularMatrixError(
                     "Schur complement G A^-1 G^T is singular: "
                     "actuators are redundant or fixed by supports"
                 )
-        self.direct = _DirectSolver(self.factor, self.Gf, Z, S_inv, self.penalty)
+        self._keep(_DirectSolver(self.factor, self.Gf, Z, S_inv, self.penalty), t_start)
+
+    def _record_inertia(self, offset: int) -> None:
+        """Negative eigenvalues of the free-DOF tangent from the factor's pivots (minus
+        ``offset`` for a bordered matrix), when the control tracks them."""
+        if self.track_inertia:
+            neg = getattr(self.factor, "negative_pivots", None)
+            self.negative_pivots = neg() - offset if neg is not None else None
+            self.inertia_seen.append(self.negative_pivots)
+
+    def _keep(self, direct: _DirectSolver | _KKTSolver, t_start: float) -> None:
+        """Make ``direct`` the factorisation of the current operator."""
+        self.direct = direct
         self.current_factored = True
         self._fact_cost = time.perf_counter() - t_start
         self._krylov_cost = 0.0
@@ -424,15 +430,8 @@ class BorderedSystem:
         perturbed = getattr(self.factor, "perturbed_pivots", None)
         if perturbed is not None and perturbed() > 0:
             return False
-        if self.track_inertia:
-            # inertia(KKT) = inertia(A) + inertia(-S); S = G A^-1 G^T > 0 when A > 0
-            neg = getattr(self.factor, "negative_pivots", None)
-            self.negative_pivots = neg() - na if neg is not None else None
-            self.inertia_seen.append(self.negative_pivots)
-        self.direct = _KKTSolver(self.factor, self.Gf, self.penalty)
-        self.current_factored = True
-        self._fact_cost = time.perf_counter() - t_start
-        self._krylov_cost = 0.0
+        self._record_inertia(na)  # inertia(KKT) = inertia(A) + inertia(-S), S > 0 when A > 0
+        self._keep(_KKTSolver(self.factor, self.Gf, self.penalty), t_start)
         return True
 
     # ---------------------------------------------------------------- solve

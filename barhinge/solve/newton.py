@@ -165,16 +165,12 @@ class _Driver:
             return float(a)
         return kd / g2 if g2 > 0 else kd
 
-    def factorize(self, e: _Eval, st: _State) -> None:
-        """Make the tangent at ``st`` the operator of the bordered system and factorise it."""
+    def factorize(self, e: _Eval, st: _State, reuse: bool = False) -> None:
+        """Make the tangent at ``st`` the operator of the bordered system and factorise it
+        (``reuse``: unless the system keeps an earlier factorisation as GMRES
+        preconditioner)."""
         self.system.row_scale = self.c_scale
-        self.system.factorize(e.ev.K, e.terms, st.mu, self.penalty or 0.0)
-
-    def prepare(self, e: _Eval, st: _State) -> None:
-        """Make the tangent at ``st`` the operator; factorise it unless the system reuses
-        an earlier factorisation as a GMRES preconditioner."""
-        self.system.row_scale = self.c_scale
-        self.system.set_operator(e.ev.K, e.terms, st.mu, self.penalty or 0.0)
+        self.system.set_operator(e.ev.K, e.terms, st.mu, self.penalty or 0.0, factorize=not reuse)
 
     def forcing(self, e: _Eval, st: _State, rf: float) -> float:
         """Relative tolerance of an inexact (GMRES) Newton solve: follows the relative
@@ -281,6 +277,8 @@ class _Driver:
                 raise _Failed("residual diverged", res)
             if e.ev.K is None:  # evaluated without tangent (convergence was expected)
                 e = self.evaluate(new)
+            # the first correction always factorises: the predictor's bar forces change the
+            # tangent too much for the previous factorisation to precondition it
             self._factorize_or_fail(e, new, res, reuse=n_iter > 0)
             n_iter += 1
             dx, dmu = self.system.solve(-e.r[free], -e.c, rtol=self.forcing(e, new, rf))
@@ -360,10 +358,7 @@ class _Driver:
         self, e: _Eval, st: _State, res: list[float], reuse: bool = False
     ) -> None:
         try:
-            if reuse:
-                self.prepare(e, st)
-            else:
-                self.factorize(e, st)
+            self.factorize(e, st, reuse)
         except SingularMatrixError as exc:
             raise _Failed(f"singular tangent ({exc})", res) from None
 
