@@ -402,13 +402,18 @@ def _fold_form_rigid(scene, out: Path) -> tuple[object, dict] | None:
 
     from barhinge.kinematics.path import RigidOptions, rigid_fold
     from barhinge.pattern.fold import write_fold_path
+    from barhinge.solve.branch import fold_weights
 
     cp = scene.model.pattern  # its state is the model's reference state X0
     t0 = time.perf_counter()
     try:
         # no DOF recount per state (a diagnostic that costs a dense SVD per state)
         opts = RigidOptions(max_cutbacks=3, check_rank=False)
-        path = rigid_fold(cp, scene.actuators, steps=scene.steps, options=opts)
+        # free motions resolved with the model's own fold springs (its rigid limit)
+        weights, _ = fold_weights(scene.model)
+        path = rigid_fold(
+            cp, scene.actuators, steps=scene.steps, options=opts, fold_stiffness=weights
+        )
     except BarhingeError as exc:
         err_console.print(f"rigid kinematics cannot fold it ({exc}); using the bar-and-hinge model",
                           highlight=False, soft_wrap=True)  # fmt: skip

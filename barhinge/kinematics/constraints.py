@@ -367,6 +367,49 @@ class RigidConstraints:
         """(3 n_cv, n_var) exact sparse Jacobian ``dr/drho``."""
         return self.evaluate(rho)[1]
 
+    def multiplier_hessian(self, rho: np.ndarray, lam: np.ndarray) -> sp.csr_matrix:
+        """(n_var, n_var) exact Hessian of ``lam . r(rho)``, with ``lam`` (3 n_cv,).
+
+        With ``a_k`` the crease axes of :meth:`loop_products` and ``dF/drho_k = [a_k]x F``,
+        ``da_k/drho_j = a_j x a_k`` for ``j < k`` (the fold about crease ``j`` turns every
+        later axis), so
+
+            d2F/drho_j drho_k = ([a_j x a_k]x + [a_k]x [a_j]x) F    (j < k),
+            d2F/drho_k^2      = [a_k]x [a_k]x F,
+
+        and ``r = vee(skew(F))`` is linear in ``F``. At a closed loop (``F = I``) the
+        ``(j, k)`` entry reduces to ``lam . (a_j x a_k) / 2`` and the diagonal vanishes.
+        """
+        F, A = self.loop_products(self.full_angles(rho))
+        L = np.asarray(lam, dtype=float).reshape(-1, 3)
+        nv, D = self.loop_var.shape
+        valid = self.loop_var >= 0
+        rows, cols, vals = [], [], []
+        for k in range(D):
+            Ak = _skew(A[:, k])
+            for j in range(k + 1):
+                if j < k:
+                    M = (_skew(np.cross(A[:, j], A[:, k])) + Ak @ _skew(A[:, j])) @ F
+                else:
+                    M = Ak @ Ak @ F
+                h = np.einsum("vi,vi->v", L, _vee_skew(M))
+                ok = valid[:, j] & valid[:, k]
+                vj, vk = self.loop_var[ok, j], self.loop_var[ok, k]
+                rows.append(vj)
+                cols.append(vk)
+                vals.append(h[ok])
+                if j < k:
+                    rows.append(vk)
+                    cols.append(vj)
+                    vals.append(h[ok])
+        if not rows:
+            return sp.csr_matrix((self.n_var, self.n_var))
+        H = sp.coo_matrix(
+            (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+            shape=(self.n_var, self.n_var),
+        )
+        return H.tocsr()
+
     # -------------------------------------------------------- coordinates from angles
     @cached_property
     def face_tree(self) -> FaceTree:
@@ -390,6 +433,15 @@ class RigidConstraints:
         ok = vs >= 0
         out[vs[ok]] = np.degrees(rho[ok])
         return out
+
+
+def _skew(a: np.ndarray) -> np.ndarray:
+    """(n, 3, 3) cross-product matrices ``[a]x`` of vectors ``a`` (n, 3)."""
+    S = np.zeros(a.shape[:-1] + (3, 3))
+    S[..., 0, 1], S[..., 0, 2] = -a[..., 2], a[..., 1]
+    S[..., 1, 0], S[..., 1, 2] = a[..., 2], -a[..., 0]
+    S[..., 2, 0], S[..., 2, 1] = -a[..., 1], a[..., 0]
+    return S
 
 
 def _vee_skew(F: np.ndarray) -> np.ndarray:

@@ -46,7 +46,7 @@ import scipy.sparse.linalg as spla
 from barhinge.actuators import Actuators
 from barhinge.errors import ConfigError, ConvergenceError
 from barhinge.kinematics.constraints import RigidConstraints
-from barhinge.kinematics.dof import FLAT_TOL, _branch_direction, select_actuators
+from barhinge.kinematics.dof import FLAT_TOL, _branch_direction
 from barhinge.kinematics.linalg import DENSE_TOL, null_space
 from barhinge.pattern.crease import CreasePattern
 from barhinge.results import FoldPath
@@ -82,6 +82,12 @@ class RigidOptions:
     cg_maxiter : int
         Conjugate-gradient iterations allowed with a reused factorisation as preconditioner
         before the normal matrix is factorised afresh.
+    energy_tol : float
+        Free DOF left by the actuators are resolved by minimising the fold-spring energy on
+        the constraint manifold; converged when the largest Newton correction of a fold angle
+        is below this (radians).
+    energy_max_iter : int
+        Newton iterations of that minimisation per step.
     """
 
     tol: float = 1e-13
@@ -91,6 +97,8 @@ class RigidOptions:
     check_actuators: bool = True
     check_rank: bool | None = None
     cg_maxiter: int = 25
+    energy_tol: float = 1e-9
+    energy_max_iter: int = 40
 
 
 class _Singular(RuntimeError):
@@ -108,13 +116,31 @@ class RigidSolver:
     options : RigidOptions
     """
 
-    def __init__(self, rc: RigidConstraints, act_var: np.ndarray, options: RigidOptions) -> None:
+    def __init__(
+        self,
+        rc: RigidConstraints,
+        act_var: np.ndarray,
+        options: RigidOptions,
+        weights: np.ndarray | None = None,
+    ) -> None:
         self.rc = rc
         self.act = np.asarray(act_var, dtype=np.int64)
         self.opt = options
         free = np.ones(rc.n_var, bool)
         free[self.act] = False
         self.free = free
+        #: fold-spring stiffness of each variable (moment per radian) and its rest angle
+        self.weights = np.ones(rc.n_var) if weights is None else np.asarray(weights, dtype=float)
+        self.rest = rc.rho0.copy()
+        #: True once the actuators are known to leave free motions (then the fold-spring
+        #: energy resolves them); None until checked at the first folded state
+        self.underactuated: bool | None = None
+        #: creases that fold against the sign the branch rule asks for (after leave_flat)
+        self.sign_conflicts: list[int] = []
+        self.energy_iterations = 0
+        self.energy_failed = False
+        self.branch_attempts = 0
+        self.mirrored = False
         self._Dfree = sp.diags(free.astype(float))
         self._Dact = sp.diags((~free).astype(float))
         self._lu = None
@@ -129,6 +155,13 @@ class RigidSolver:
     # ---------------------------------------------------------------- linear algebra
     def _factor(self, J: sp.csr_matrix) -> None:
         K = (J.T @ J).tocsr()
+        # a tiny stiffness-weighted regularisation keeps the normal matrix regular where the
+        # actuators leave free motions (the right-hand side J^T r has no component along
+        # them, so the step stays the minimum-norm Gauss-Newton step)
+        if self.underactuated is not False:
+            d = K.diagonal()
+            eps = 1e-12 * float(d.max(initial=1.0)) / float(self.weights.max(initial=1.0))
+            K = K + sp.diags(eps * self.weights)
         Kf = self._Dfree @ K @ self._Dfree + self._Dact
         try:
             # symmetric positive (semi)definite; the solver's fastest backend (PARDISO where
@@ -192,6 +225,8 @@ class RigidSolver:
                 return x
             z = self._solve(r)
             rz_new = dot(r, z)
+            if not (rz > 0.0 and np.isfinite(rz_new)):
+                return None  # breakdown: refactorise instead
             p = z + (rz_new / rz) * p
             rz = rz_new
         return None
@@ -255,14 +290,21 @@ class RigidSolver:
         return rho + d + da, misfit
 
     def leave_flat(self, rho: np.ndarray, t_new: np.ndarray) -> np.ndarray:
-        """First state off the flat one, on the branch picked by the pattern.
+        """First state off the flat one, on the branch the pattern asks for.
 
-        Guess: the branch direction (target fold angles, else M/V signs) scaled so that the
-        actuators match ``t_new``. The flat state is a bifurcation point where several
-        branches start (e.g. the two modes of a degree-4 vertex) and plain Newton may jump
-        between them; Levenberg-Marquardt steps ``(J_F^T J_F + mu I) d = -J_F^T r`` keep the
-        iterate near the guess and land on the branch closest to it. Returns the (possibly
-        unconverged) result; the regular corrector finishes it.
+        The flat state is a bifurcation point where several branches start (e.g. the two
+        modes of a degree-4 vertex), and the actuator targets alone do not say which one to
+        take. The rule (docs/solver.md, "Leaving the flat state"): the branch whose creases
+        fold with the signs of the *branch direction* ``d`` (the pattern's target fold angles
+        where given, else its M/V assignment, V +1, M -1), flipped as a whole when the
+        actuator targets ask for the opposite signs. Creases with ``d = 0`` may take either
+        sign.
+
+        Levenberg-Marquardt on ``|r(x)|^2 + |min(0, s_i x_i)|^2`` (closure residual and the
+        sign violations ``s = sign(scale d)``) from the guess ``x = scale d`` (actuators at
+        ``t_new``) lands on a state of that branch when one exists near the guess; otherwise
+        the creases still folding against their signs are kept in ``sign_conflicts``.
+        Returns the (possibly unconverged) result; the regular corrector finishes it.
         """
         d = _branch_direction(self.rc)
         dA = d[self.act]
@@ -271,33 +313,156 @@ class RigidSolver:
             s = float(np.median(t_new[ok] / dA[ok]))
         else:
             s = float(np.max(np.abs(t_new)) / max(np.max(np.abs(d)), 1e-300))
-        x = rho + s * d
-        x[self.act] = t_new
+        sgn = np.where(self.free, np.sign(s * d), 0.0)
+        self.mirrored = s < 0.0
         self._lu = None
-        r, J = self.rc.evaluate(x)
-        f = float(r @ r)
+        # the guess scales every crease alike; where the branch needs very different
+        # magnitudes (e.g. mode 2 of a degree-4 vertex) the least-squares landscape has
+        # local minima on the sign boundary, so further guesses rescale the free creases
+        # (deterministic log-uniform factors in [1/8, 8]); the first that closes wins
+        rng = np.random.default_rng(0)
+        best = None
+        for attempt in range(8):
+            scale = (
+                np.ones(self.rc.n_var)
+                if attempt == 0
+                else 8.0 ** rng.uniform(-1.0, 1.0, self.rc.n_var)
+            )
+            x0 = rho + s * d * scale
+            x0[self.act] = t_new
+            x, rmax, conflicts = self._branch_lm(rho, x0, sgn)
+            key = (len(conflicts) > 0, rmax)
+            if best is None or key < best[0]:
+                best = (key, x, conflicts)
+            if rmax <= 1e-6 and not conflicts:
+                break
+        _, x, self.sign_conflicts = best
+        self.branch_attempts = attempt + 1
+        return x
+
+    def _branch_lm(
+        self, rho: np.ndarray, x: np.ndarray, sgn: np.ndarray
+    ) -> tuple[np.ndarray, float, list[int]]:
+        """Levenberg-Marquardt on ``|r(x)|^2 + |min(0, sgn (x - rho))|^2`` from ``x`` with the
+        actuators held; returns (x, max |r|, variables against their sign)."""
+
+        def residuals(y: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix, np.ndarray]:
+            r, J = self.rc.evaluate(y)
+            viol = np.minimum(sgn * (y - rho), 0.0)
+            return r, J, viol
+
+        r, J, viol = residuals(x)
+        f = float(r @ r + viol @ viol)
         mu = None
         eye = sp.identity(self.rc.n_var, format="csr")
         for _ in range(200):
-            if np.max(np.abs(r), initial=0.0) <= 1e-6:  # close enough: Newton finishes
-                break
-            K = (J.T @ J).tocsr()
+            if np.max(np.abs(r), initial=0.0) <= 1e-6 and np.max(-viol, initial=0.0) <= 1e-9:
+                break  # close enough: Newton finishes
+            K = (J.T @ J).tocsr() + sp.diags((viol < 0).astype(float))
             if mu is None:
                 mu = 1e-3 * float(K.diagonal().max(initial=1.0))
             Kf = self._Dfree @ (K + mu * eye) @ self._Dfree + self._Dact
+            g = J.T @ r + sgn * viol
             step = spla.splu(Kf.tocsc(), permc_spec="MMD_AT_PLUS_A").solve(
-                np.where(self.free, -(J.T @ r), 0.0)
+                np.where(self.free, -g, 0.0)
             )
             step[~self.free] = 0.0
-            r2, J2 = self.rc.evaluate(x + step)
-            f2 = float(r2 @ r2)
+            r2, J2, v2 = residuals(x + step)
+            f2 = float(r2 @ r2 + v2 @ v2)
             if f2 < f:
-                x, r, J, f = x + step, r2, J2, f2
+                x, r, J, viol, f = x + step, r2, J2, v2, f2
                 mu *= 0.3
             else:
                 mu *= 10.0
+                if mu > 1e12:
+                    break
             self.iterations += 1
-        return x
+        size = max(float(np.max(np.abs(x - rho), initial=0.0)), 1e-300)
+        conflicts = np.flatnonzero(-viol > 1e-3 * size).tolist()
+        return x, float(np.max(np.abs(r), initial=0.0)), conflicts
+
+    def lands_flat(self, rho: np.ndarray, t: np.ndarray) -> bool:
+        """Whether ``rho`` (converged, actuators at ``t``) is the flat state up to the
+        corrector's landing error. With every actuator at 0 the flat state lies on every
+        branch, but the closure residual is only quadratic in the distance from it, so a
+        corrector may stop up to ~sqrt(tol) away: such a landing is snapped onto it."""
+        if np.any(np.abs(t) > 1e-12) or np.max(np.abs(rho), initial=0.0) > 1e-3:
+            return False
+        flat = np.zeros_like(rho)
+        return bool(float(np.max(np.abs(self.rc.residual(flat)), initial=0.0)) <= self.opt.tol)
+
+    # ------------------------------------------------------------ free DOF: energy
+    def energy(self, rho: np.ndarray) -> float:
+        """Fold-spring energy ``1/2 sum w (rho - rho_rest)^2`` (moment x radian)."""
+        e = rho - self.rest
+        return 0.5 * float(self.weights @ (e * e))
+
+    def minimize(self, rho: np.ndarray) -> tuple[np.ndarray, bool]:
+        """Minimise the fold-spring energy over the free motions at fixed actuators.
+
+        Starting from a state ``rho`` on the constraint manifold, Newton steps on the KKT
+        conditions with the exact Hessian of the Lagrangian (fold springs plus
+        :meth:`RigidConstraints.multiplier_hessian`), the tangential system
+
+            [W + H(lam)  J^T ] [d  ]   [-W (rho - rho_rest)]
+            [J          -dI  ] [lam] = [ 0                 ]
+
+        on the free creases (``d`` a tiny regularisation: redundant loop equations make the
+        multipliers non-unique), then the corrector back onto the manifold and a
+        backtracking line search on the energy. This is the limit of the bar-and-hinge model
+        as the panels become rigid (stationary fold-spring energy subject to rigid folding).
+        Returns (rho, converged).
+        """
+        rc, free = self.rc, self.free
+        fi = np.flatnonzero(free)
+        W = self.weights
+        delta = 1e-13 / float(W.max(initial=1.0))
+        lam = None
+        e0 = self.energy(rho)
+        for _ in range(self.opt.energy_max_iter):
+            r, J = rc.evaluate(rho)
+            g = W * (rho - self.rest)
+            Jf = J[:, fi]
+            Hf = sp.diags(W[fi])
+            if lam is not None:
+                Hf = Hf + rc.multiplier_hessian(rho, lam)[fi][:, fi]
+            m = J.shape[0]
+            K = sp.bmat([[Hf, Jf.T], [Jf, -delta * sp.identity(m)]], format="csc")
+            rhs = np.concatenate([-g[fi], np.zeros(m)])
+            try:
+                sol = spla.splu(K, permc_spec="MMD_AT_PLUS_A").solve(rhs)
+            except RuntimeError:  # exactly singular KKT matrix
+                if lam is None:
+                    return rho, False
+                lam = None
+                continue
+            d = np.zeros(rc.n_var)
+            d[fi] = sol[: len(fi)]
+            lam_new = sol[len(fi) :]
+            if not np.all(np.isfinite(sol)):
+                return rho, False
+            dmax = float(np.max(np.abs(d), initial=0.0))
+            log.debug("minimize: |d| %.3e, newton %s, E %.6e", dmax, lam is not None, e0)
+            if dmax <= self.opt.energy_tol:
+                return rho, True
+            if dmax > 0.5:
+                d *= 0.5 / dmax
+            # line search on the energy, each trial projected back onto the manifold
+            alpha, accepted = 1.0, False
+            for _ls in range(12):
+                trial, _, ok = self.corrector(rho + alpha * d)
+                if ok and (self.energy(trial) <= e0 + 1e-14 * max(abs(e0), 1.0) or dmax < 1e-6):
+                    rho, e0, accepted = trial, self.energy(trial), True
+                    break
+                alpha *= 0.5
+            self.energy_iterations += 1
+            if not accepted:
+                if lam is None:
+                    return rho, False
+                lam = None  # indefinite Lagrangian Hessian: fall back to the spring metric
+                continue
+            lam = lam_new
+        return rho, False
 
 
 def _extrapolate(hist: list[tuple[float, np.ndarray]], s_new: float) -> np.ndarray | None:
@@ -337,8 +502,15 @@ def rigid_fold(
     *,
     triangulated: bool = False,
     options: RigidOptions | None = None,
+    fold_stiffness: np.ndarray | float | None = None,
+    diagonal_stiffness: float | None = None,
 ) -> FoldPath:
     """Fold ``cp`` as a rigid origami by driving actuator creases.
+
+    Where the actuators leave free motions, they are resolved by minimising the fold-spring
+    energy ``1/2 sum k_e (rho_e - rho_e0)^2`` subject to rigid folding: the limit of the
+    bar-and-hinge model as panels and bars become rigid. At the flat state the path leaves
+    along the branch that matches the M/V assignment (see :meth:`RigidSolver.leave_flat`).
 
     Parameters
     ----------
@@ -355,6 +527,13 @@ def rigid_fold(
     triangulated : bool
         Let panels fold along diagonals (else panels stay rigid and planar).
     options : RigidOptions, optional
+    fold_stiffness : float or (n_edges,) float, optional
+        Fold-spring stiffness of each pattern edge (moment per radian); default: the crease
+        length (a uniform stiffness per unit length, as the bar-and-hinge default). Only
+        ratios matter.
+    diagonal_stiffness : float, optional
+        With ``triangulated``: stiffness of the panel diagonals (default 1e4 x the median
+        fold stiffness: panels bend far less readily than creases fold).
 
     Returns
     -------
@@ -388,7 +567,8 @@ def rigid_fold(
     if act.table_deg is not None:
         steps = len(act.table_deg)
     sched = np.radians(act.schedule(steps, start_deg=np.degrees(rho[av])))
-    solver = RigidSolver(rc, av, opt)
+    weights = _spring_weights(rc, fold_stiffness, diagonal_stiffness)
+    solver = RigidSolver(rc, av, opt, weights)
     if rc.holes:
         log.warning(
             "the pattern has %d hole(s): loops of panels around holes are not constrained; "
@@ -405,6 +585,7 @@ def rigid_fold(
     dofs: list[int] = []
     events: list[str] = []
     checked = False
+    free_dof: int | None = None
     track: list[tuple[float, np.ndarray]] = [(0.0, rho.copy())]
 
     def dof_at(x: np.ndarray) -> int:
@@ -416,7 +597,19 @@ def rigid_fold(
 
     def partial(msg: str) -> FoldPath:
         return _make_path(
-            rc, cp, act, sched, states, iters, hists, walls, False, msg, dofs, events, opt
+            solver,
+            cp,
+            act,
+            sched,
+            states,
+            iters,
+            hists,
+            walls,
+            False,
+            msg,
+            dofs,
+            events,
+            free_dof,
         )
 
     def failure(msg: str, s: int, hist: list[float]) -> ConvergenceError:
@@ -438,13 +631,26 @@ def rigid_fold(
                 solver, rho, sched[s - 1], sched[s], opt, hist_all, track, check_misfit
             )
         except _Singular:
-            x = solver.last_guess if solver.last_guess is not None else rho
-            _check_actuators(rc, x, av, act.edges)
             msg = (
                 f"step {s}: the Jacobian of the free creases is singular (a bifurcation "
                 f"point or actuators that leave free motions)"
             )
             raise failure(msg, s, hist_all) from None
+        if s == 1 and solver.mirrored and not solver.sign_conflicts:
+            ev = (
+                "step 1: the actuator targets ask for the mirror image of the branch "
+                "direction: every crease folds with the opposite of its M/V sign"
+            )
+            events.append(ev)
+            log.warning(ev)
+        if s == 1 and solver.sign_conflicts:
+            bad = sorted({int(rc.var_source_edge[v]) for v in solver.sign_conflicts} - {-1})
+            ev = (
+                f"step 1: no rigid branch off the flat state near the M/V assignment: creases "
+                f"{bad} fold against it; choose the branch with target fold angles"
+            )
+            events.append(ev)
+            log.warning(ev)
         if not ok and over < 0 and np.max(np.abs(rho), initial=0.0) >= FLAT_TOL:
             # would the tangent towards the target carry a crease past +-180 deg?
             try:
@@ -467,6 +673,12 @@ def rigid_fold(
                 msg = (
                     f"step {s}: locked: crease edge {e} is at {ang:.3f} deg, the panels meet "
                     f"before the actuator targets"
+                )
+            elif solver.energy_failed:
+                msg = (
+                    f"step {s}: the fold-spring energy over the free motions the actuators "
+                    f"leave did not reach a minimum in {opt.energy_max_iter} Newton iterations "
+                    f"after {opt.max_cutbacks} cut-backs; drive more creases"
                 )
             else:
                 flat = np.max(np.abs(rho), initial=0.0) < FLAT_TOL
@@ -498,7 +710,7 @@ def rigid_fold(
                 msg, step=s - 1, load_factor=s / steps, residuals=hist_all, last_state=partial(msg)
             )
         if opt.check_actuators and not checked and np.max(np.abs(rho)) >= FLAT_TOL:
-            _check_actuators(rc, rho, av, act.edges)
+            free_dof = _check_actuators(rc, rho, av, act.edges)
             checked = True
         states.append(rho.copy())
         iters.append(solver.iterations)
@@ -510,7 +722,9 @@ def rigid_fold(
                 ev = f"step {s}: DOF changed from {dofs[-2]} to {dofs[-1]} (singular state)"
                 events.append(ev)
                 log.warning(ev)
-    return _make_path(rc, cp, act, sched, states, iters, hists, walls, True, "", dofs, events, opt)
+    return _make_path(
+        solver, cp, act, sched, states, iters, hists, walls, True, "", dofs, events, free_dof
+    )
 
 
 def _advance(
@@ -565,6 +779,15 @@ def _advance(
             over = int(np.argmax(np.abs(new)))
         elif not ok:
             over = -1
+        if ok and solver.lands_flat(new, b):
+            new = np.zeros_like(new)
+        if ok and np.max(np.abs(new), initial=0.0) >= FLAT_TOL:
+            if solver.underactuated is None:
+                solver.underactuated = _free_motions(solver.rc, new, solver.act) > 0
+            if solver.underactuated:
+                new, ok = solver.minimize(new)
+                if not ok:
+                    solver.energy_failed = True
         if ok:
             cur = new
             track.append((s_new, new.copy()))
@@ -582,19 +805,70 @@ def _advance(
     return True, cur, -1
 
 
+def _spring_weights(
+    rc: RigidConstraints,
+    fold_stiffness: np.ndarray | float | None,
+    diagonal_stiffness: float | None,
+) -> np.ndarray:
+    """(n_var,) fold-spring stiffness of each variable: pattern creases from
+    ``fold_stiffness`` (scalar or per source edge; default the crease length), panel
+    diagonals ``diagonal_stiffness`` (default 1e4 x the median crease)."""
+    pat = rc.pattern
+    E = pat.edges[rc.crease_edge]
+    length = np.linalg.norm(pat.vertices3d[E[:, 1]] - pat.vertices3d[E[:, 0]], axis=1)
+    src = rc.var_source_edge
+    crease = src >= 0
+    w = np.zeros(rc.n_var)
+    if fold_stiffness is None:
+        w[crease] = length[crease]
+    else:
+        k = np.asarray(fold_stiffness, dtype=float)
+        if k.ndim == 0:
+            w[crease] = float(k)
+        elif k.shape == (rc.source.n_edges,):
+            w[crease] = k[src[crease]]
+        else:
+            raise ConfigError(
+                f"fold_stiffness has shape {k.shape}; expected a scalar or "
+                f"({rc.source.n_edges},) (one per pattern edge)"
+            )
+    if not np.all(np.isfinite(w)) or np.any(w[crease] <= 0):
+        raise ConfigError("fold_stiffness must be finite and > 0 on every crease")
+    if (~crease).any():
+        kd = 1e4 * float(np.median(w[crease])) if diagonal_stiffness is None else diagonal_stiffness
+        if not (np.isfinite(kd) and kd > 0):
+            raise ConfigError(f"diagonal_stiffness = {kd}; expected a finite value > 0")
+        w[~crease] = kd
+    return w
+
+
+def _free_motions(rc: RigidConstraints, rho: np.ndarray, av: np.ndarray) -> int:
+    """Number of motions the actuators ``av`` leave free at the folded state ``rho``:
+    the DOF (nullity of the Jacobian) minus the rank of the actuator rows of its null
+    space."""
+    ns = null_space(rc.jacobian(rho))
+    NA = ns.basis[av]
+    r = int(np.linalg.matrix_rank(NA, tol=1e-8)) if NA.size else 0
+    return ns.basis.shape[1] - r
+
+
 def _check_actuators(
     rc: RigidConstraints, rho: np.ndarray, av: np.ndarray, edges: np.ndarray
-) -> None:
-    """ConfigError if the actuators leave free motions at the folded state ``rho``."""
+) -> int:
+    """Free motions the actuators leave at the folded state ``rho`` (resolved by the
+    fold-spring energy); logs when they over-determine the motion."""
     ns = null_space(rc.jacobian(rho))
     k = ns.basis.shape[1]
     NA = ns.basis[av]
     r = int(np.linalg.matrix_rank(NA, tol=1e-8)) if NA.size else 0
     if r < k:
-        sug = select_actuators(rc, ns)
-        raise ConfigError(
-            f"the actuators {edges.tolist()} fix only {r} of the {k} DOF at the first folded "
-            f"state: {k - r} free motion(s) remain; drive e.g. edges {sug.tolist()}"
+        log.info(
+            "the actuators %s fix %d of the %d DOF; the other %d are resolved by minimising "
+            "the fold-spring energy",
+            edges.tolist(),
+            r,
+            k,
+            k - r,
         )
     if len(av) > r:
         log.info(
@@ -602,11 +876,13 @@ def _check_actuators(
             edges.tolist(),
             k,
         )
+    return k - r
 
 
 def _make_path(
-    rc, cp, act, sched, states, iters, hists, walls, converged, msg, dofs, events, opt
+    solver, cp, act, sched, states, iters, hists, walls, converged, msg, dofs, events, free_dof
 ) -> FoldPath:
+    rc, opt = solver.rc, solver.opt
     R = np.asarray(states)
     n = len(R)
     X = np.stack([rc.coordinates(r) for r in R])
@@ -620,6 +896,14 @@ def _make_path(
         "dof": dofs,
         "events": events,
         "holes": rc.holes,
+        "free_dof": free_dof,
+        "fold_energy": [solver.energy(r) for r in R],
+        "energy_iterations": solver.energy_iterations,
+        "branch": ("target fold angles" if np.any(cp.fold_angles != 0) else "M/V assignment"),
+        "mirrored": bool(solver.mirrored),
+        "sign_conflicts": sorted(
+            {int(rc.var_source_edge[v]) for v in solver.sign_conflicts} - {-1}
+        ),
     }
     return FoldPath(
         X=X,

@@ -335,6 +335,11 @@ def read_svg(
     ang = np.array(ang_l, float)
     keep = E[:, 0] != E[:, 1]
     E, asg, ang = E[keep], asg[keep], ang[keep]
+    if len(E) == 0:
+        raise PatternError(
+            f"{where}: every line is shorter than the merge tolerance {tol:.3g}; "
+            "expected crease lines longer than that"
+        )
     for _ in range(3):
         n_before = (len(V), len(E))
         V, E, parent = _split(V, E, tol)

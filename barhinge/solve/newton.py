@@ -21,6 +21,7 @@ import numpy as np
 
 from barhinge.errors import ConfigError, ConvergenceError
 from barhinge.results import FoldPath
+from barhinge.solve.branch import creases_against_assignment, is_flat, rigid_prediction
 from barhinge.solve.controls import (
     BorderedSystem,
     Timer,
@@ -114,6 +115,10 @@ class _Driver:
         # what a change of the free-DOF tangent's inertia means under this control: a load
         # maximum (load control) or a turning point of the controlled displacement
         self._critical = "limit point" if scene.control == "load" else "snap-back"
+        # leaving a flat start: the first increment is predicted by the rigid fold
+        # (barhinge.solve.branch); its record says which branch was taken
+        self._flat_start = bool(self.n_act and self.opts.flat_start == "rigid" and is_flat(model))
+        self.flat_start_record: dict[str, Any] | None = None
 
     # ------------------------------------------------------------ schedules
     def targets(self, t: float) -> np.ndarray:
@@ -228,7 +233,10 @@ class _Driver:
         prev = self._prev
         prev2 = self._prev2
         extrapolate = o.predictor in ("secant", "quadratic") and not self._retry_tangent
-        if prev is not None and prev.t < st.t and extrapolate:
+        flat = self._flat_start and st.t == 0.0 and self._flat_prediction(st, t1, lam1)
+        if flat:
+            new = flat
+        elif prev is not None and prev.t < st.t and extrapolate:
             if o.predictor == "quadratic" and prev2 is not None and prev2.t < prev.t:
                 # Lagrange extrapolation through the last three converged states
                 ta, tb, tc = prev2.t, prev.t, st.t
@@ -284,6 +292,45 @@ class _Driver:
             dx, dmu = self.system.solve(-e.r[free], -e.c, rtol=self.forcing(e, new, rf))
             new, e, alpha = self._line_search(new, e, dx, dmu, self._expects_convergence(res))
             dx_last = alpha * dx
+
+    def _flat_prediction(self, st: _State, t1: float, lam1: float) -> _State | None:
+        """Rigid-fold prediction of the first increment off the flat start (None when no
+        rigid fold reaches the targets; the tangent predictor is used then)."""
+        target = self.X0.ravel().copy()
+        target[self.fixed] = self.fixed_coords(t1)
+        pred = rigid_prediction(
+            self.model,
+            self.scene.actuators.edges,
+            np.degrees(self.targets(t1)),
+            self.fixed.reshape(-1, 3),
+            target.reshape(-1, 3),
+        )
+        if pred is None:
+            self.flat_start_record = {"predictor": "tangent (no rigid fold found)"}
+            return None
+        self.flat_start_record = pred.record
+        new = _State(pred.X.ravel().copy(), st.mu.copy(), lam1, t1)
+        new.x[self.fixed] = self.fixed_coords(t1)
+        return new
+
+    def branch_events(self) -> list[str]:
+        """Events of the flat start: the rigid predictor's, and creases of the last state
+        that fold against their M/V assignment."""
+        rec = self.flat_start_record
+        if rec is None or not self.records:
+            return []
+        events = list(rec.get("events", []))
+        bad = creases_against_assignment(
+            self.model, self.records[-1]["fold"], mirrored=bool(rec.get("mirrored", False))
+        )
+        if bad:
+            events.append(
+                f"{len(bad)} crease(s) fold against their M/V assignment by more than 1 deg "
+                f"(edges {bad[:10]}{' ...' if len(bad) > 10 else ''}): the panels bend "
+                "instead of following the assigned mode (stiffer panels or more actuators "
+                "follow it)"
+            )
+        return events
 
     def _check_inertia(self, res: list[float]) -> None:
         """Under load control an increment must not cross a critical point: the number of
@@ -414,6 +461,8 @@ class _Driver:
             "linear_solver": self.backend.name,
             "auto_restrained": bool(self.scene.auto_restrained),
             "timing": self.timer.as_dict(),
+            "flat_start": self.flat_start_record,
+            "branch_events": self.branch_events(),
         }
         return FoldPath(
             X=np.stack([r["X"] for r in rec]),

@@ -73,6 +73,12 @@ class SolverOptions:
         Load-factor increment of the first arc-length (MGDCM) step; default ``1/steps``.
     max_arc_steps : int or None
         Cap on arc-length increments (default ``10 * steps``).
+    flat_start : str
+        How an actuated scene leaves a flat (singular) start, where the tangent predictor
+        cannot see the folding mode: ``"rigid"`` (default) predicts the first increment by
+        the energy-minimising rigid fold on the branch of the M/V assignment
+        (:mod:`barhinge.solve.branch`); ``"tangent"`` uses the plain tangent predictor (the
+        branch is then whatever Newton finds; use it with an imperfect start).
     """
 
     tol_force: float = 1e-8
@@ -91,6 +97,7 @@ class SolverOptions:
     krylov_max: int = 30
     arc_length_increment: float | None = None
     max_arc_steps: int | None = None
+    flat_start: str = "rigid"
 
     def __post_init__(self) -> None:
         for name in ("tol_force", "tol_disp", "tol_angle", "divergence_ratio"):
@@ -107,6 +114,10 @@ class SolverOptions:
             raise ConfigError(
                 f"solver option predictor = {self.predictor!r}; "
                 "expected 'secant', 'quadratic' or 'tangent'"
+            )
+        if self.flat_start not in ("rigid", "tangent"):
+            raise ConfigError(
+                f"solver option flat_start = {self.flat_start!r}; expected 'rigid' or 'tangent'"
             )
         if not (isinstance(self.line_search, int) and self.line_search >= 0):
             raise ConfigError(f"solver option line_search = {self.line_search!r}; expected >= 0")

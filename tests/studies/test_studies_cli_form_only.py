@@ -64,10 +64,11 @@ def test_form_only_keeps_the_compliant_model_for_loaded_scenes() -> None:
     assert form_only_model(load_scene(SCENES / "miura_actuated.toml"))[0] == "rigid"
 
 
-def test_form_only_falls_back_when_rigid_kinematics_cannot_follow(tmp_path: Path) -> None:
+def test_form_only_resolves_free_motions_as_the_rigid_limit(tmp_path: Path) -> None:
     """A Yoshimura arch (12 rigid DOF) driven by its 9 horizontal creases alone leaves free
-    motions: rigid kinematics refuses (ConfigError naming the missing DOF) and the CLI falls
-    back to the bar-and-hinge solver (helper returns None, nothing written)."""
+    motions: rigid kinematics resolves them by minimising the model's fold-spring energy,
+    and the form agrees with the bar-and-hinge model made 1e5 x stiffer in its panels (an
+    independent solver; the gap is O(1 / ratio))."""
     from barhinge.cli import _fold_form_rigid
 
     cp = bh.patterns.yoshimura(4, 3, fold=5.0)
@@ -77,9 +78,31 @@ def test_form_only_falls_back_when_rigid_kinematics_cannot_follow(tmp_path: Path
         (np.abs(flat[E[:, 0], 1] - flat[E[:, 1], 1]) < 1e-9) & np.isin(cp.assignment, ["M", "V"])
     )
     assert len(horizontal) == 9
-    model = bh.BarHingeModel.from_pattern(cp, "N5B8")
     target = np.asarray(bh.patterns.yoshimura(4, 3, fold=30.0).fold_angles)[horizontal]
-    scene = bh.Scene(model, actuators=bh.Actuators(edges=horizontal, targets_deg=target), steps=2)
+    acts = bh.Actuators(edges=horizontal, targets_deg=target)
+    model = bh.BarHingeModel.from_pattern(cp, "N5B8")
+    scene = bh.Scene(model, actuators=acts, steps=2)
     assert form_only_model(scene)[0] == "rigid"
+    path, info = _fold_form_rigid(scene, tmp_path / "out")
+    assert path.converged and path.meta["free_dof"] == 3
+    stiff = bh.BarHingeModel.from_pattern(cp, "N5B8", stiffness_ratio=1e5)
+    bar = bh.solve(bh.Scene(stiff, actuators=acts, steps=2))
+    gap = np.abs(bar.fold_angles_deg[-1] - path.fold_angles_deg[-1]).max()
+    assert gap < 0.01, gap
+
+
+def test_form_only_falls_back_when_rigid_kinematics_cannot_follow(tmp_path: Path) -> None:
+    """Two creases of a 1-DOF Miura driven with targets that contradict each other: rigid
+    kinematics refuses (ConfigError) and the CLI falls back to the bar-and-hinge solver
+    (helper returns None, nothing written)."""
+    from barhinge.cli import _fold_form_rigid
+
+    cp = bh.patterns.miura(2, 2, fold=30.0)
+    lay = bh.patterns.miura_layout(2, 2)
+    z, s = int(lay.interior_zigzag_edges[0]), int(lay.interior_straight_edges[0])
+    acts = bh.Actuators(
+        edges=[z, s], targets_deg=[cp.fold_angles[z] * 1.5, cp.fold_angles[s] * 0.5]
+    )
+    scene = bh.Scene(bh.BarHingeModel.from_pattern(cp, "N5B8"), actuators=acts, steps=2)
     assert _fold_form_rigid(scene, tmp_path / "out") is None
     assert not (tmp_path / "out").exists()

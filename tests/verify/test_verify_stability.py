@@ -71,5 +71,6 @@ def test_limit_load_checked_against_closed_form(study):
 
 def test_branch_choice_selects_the_assigned_branch(study):
     rec = {r["id"]: r for r in study.RECORDS}
-    assert rec["flat-rigid-mv"]["status"] == "bifurcation"
+    assert rec["flat-rigid-mv"]["status"] == "converged"
     assert rec["flat-rigid-branch"]["status"] == "converged"
+    assert rec["flat-dof"]["status"] == "bifurcation"

@@ -1,0 +1,204 @@
+"""Leaving a flat (singular) start: the rigid-fold predictor of the bar-and-hinge solver.
+
+At the flat state every folding mode of a tessellation is a zero-stiffness direction to
+first order (the bars stretch only to second order), so the tangent predictor of an actuated
+scene sees none of them: it bends the panels next to the actuators, and Newton converges to
+whatever equilibrium lies nearest, often one with creases folded against their assignment and
+crumpled panels. The flat state is a bifurcation point; the branch must be chosen.
+
+The rule (docs/solver.md, "Leaving the flat state"): the first increment is predicted by
+the rigid fold of the pattern to the increment's actuator targets, computed by
+:func:`barhinge.kinematics.rigid_fold` with the model's own fold-spring stiffnesses, i.e. the
+limit of the bar-and-hinge model as bars and panels become rigid, on the branch whose creases
+fold with the signs of the pattern's target fold angles or M/V assignment. Where panels cannot
+stay rigid (a pattern that is not rigidly foldable) the panels' diagonals may fold with the
+model's bending stiffness. The predicted vertices are placed on the supports by the rigid
+motion that best fits them; centre nodes (N5B8) follow as the mean of their face's corners
+(exact for a rigid panel). Newton then corrects the prediction into the bar-and-hinge
+equilibrium of that branch.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+from typing import Any
+
+import numpy as np
+
+from barhinge.actuators import Actuators
+from barhinge.errors import BarhingeError
+from barhinge.model.triangulate import triangulate
+
+__all__ = [
+    "FlatStart",
+    "creases_against_assignment",
+    "fold_weights",
+    "is_flat",
+    "rigid_prediction",
+]
+
+log = logging.getLogger(__name__)
+
+#: a model whose fold hinges all lie within this of 0 rad starts flat
+FLAT_START_TOL = 1e-6
+
+
+@dataclasses.dataclass(frozen=True)
+class FlatStart:
+    """A predicted first state off the flat start and how it was chosen.
+
+    Attributes
+    ----------
+    X : (n_nodes, 3) float
+        Predicted node coordinates (supports at their prescribed positions where a rigid
+        motion can put them there).
+    record : dict
+        What was chosen: ``predictor`` ("rigid panels" or "triangulated panels"),
+        ``branch`` ("M/V assignment" or "target fold angles"), ``mirrored``,
+        ``sign_conflicts`` (pattern edges against the branch signs), ``free_dof`` (motions
+        the actuators leave, resolved by the fold-spring energy), ``events``.
+    """
+
+    X: np.ndarray
+    record: dict[str, Any]
+
+
+def is_flat(model: Any) -> bool:
+    """True when every fold hinge of ``model`` is flat in its reference state."""
+    rest = np.asarray(model.rest_angle)[np.asarray(model.hinge_kind) == "fold"]
+    return bool(rest.size) and float(np.max(np.abs(rest))) < FLAT_START_TOL
+
+
+def fold_weights(model: Any) -> tuple[np.ndarray, float]:
+    """(n_edges,) fold-spring stiffness per pattern edge (1 where no fold hinge) and the
+    median bending-hinge stiffness (for triangulated panels)."""
+    kind = np.asarray(model.hinge_kind)
+    k = np.asarray(model.hinge_k, float)
+    edge = np.asarray(model.hinge_edge)
+    w = np.ones(model.pattern.n_edges)
+    f = kind == "fold"
+    w[edge[f]] = np.maximum(k[f], 1e-300)
+    kb = float(np.median(k[~f])) if (~f).any() else 1e4 * float(np.median(k[f]))
+    return w, kb
+
+
+def _node_coordinates(model: Any, V: np.ndarray) -> np.ndarray:
+    """(n_nodes, 3) model nodes from pattern vertices ``V``: centre nodes at the mean of
+    their face's corners."""
+    cp = model.pattern
+    n = int(model.n_nodes)
+    if n == cp.n_vertices:
+        return V.copy()
+    centre_face = triangulate(cp, model.scheme).centre_face
+    C = np.stack([V[list(cp.faces[f])].mean(axis=0) for f in centre_face])
+    return np.vstack([V, C])
+
+
+def _fit_supports(X: np.ndarray, fixed: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """Rigid motion of ``X`` (n, 3) that best puts its fixed components (boolean (n, 3)) on
+    ``target`` (n, 3) in least squares: Gauss-Newton on a rotation vector and a
+    translation."""
+    rows = np.argwhere(fixed)
+    if len(rows) == 0:
+        return X
+    nodes = np.unique(rows[:, 0])
+    c = X[nodes].mean(axis=0)
+    Y = X - c
+    R = np.eye(3)
+    t = target[nodes].mean(axis=0) if len(nodes) else np.zeros(3)
+    for _ in range(20):
+        P = Y[rows[:, 0]] @ R.T + t  # current positions of the fixed nodes
+        res = P[np.arange(len(rows)), rows[:, 1]] - target[rows[:, 0], rows[:, 1]]
+        # d(R y)/d(omega) = -[R y]x ; d/dt = I
+        Ry = Y[rows[:, 0]] @ R.T
+        e = np.eye(3)[rows[:, 1]]
+        Jm = np.hstack([np.cross(Ry, e), e])  # e . (omega x Ry) = omega . (Ry x e)
+        step, *_ = np.linalg.lstsq(Jm, -res, rcond=None)
+        w, dt = step[:3], step[3:]
+        th = float(np.linalg.norm(w))
+        if th > 0:
+            k = w / th
+            K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+            R = (np.eye(3) + np.sin(th) * K + (1 - np.cos(th)) * K @ K) @ R
+        t = t + dt
+        if np.max(np.abs(step)) < 1e-14:
+            break
+    return Y @ R.T + t
+
+
+def rigid_prediction(
+    model: Any,
+    actuator_edges: np.ndarray,
+    targets_deg: np.ndarray,
+    fixed: np.ndarray,
+    fixed_target: np.ndarray,
+) -> FlatStart | None:
+    """Rigid-fold prediction of the state where the actuators reach ``targets_deg``.
+
+    Parameters
+    ----------
+    model : BarHingeModel, flat in its reference state.
+    actuator_edges : (n_act,) int, pattern edge ids.
+    targets_deg : (n_act,) float, actuator fold angles of the predicted state (degrees,
+        valley > 0).
+    fixed : (n_nodes, 3) bool, supported or prescribed components.
+    fixed_target : (n_nodes, 3) float, their positions at the predicted state.
+
+    Returns
+    -------
+    FlatStart, or None when no rigid fold (with rigid or with triangulated panels) reaches
+    the targets; the reason is logged.
+    """
+    # imported here: kinematics.path uses the solver's linear-algebra backends
+    from barhinge.kinematics.path import RigidOptions, rigid_fold
+
+    cp = model.pattern
+    w, kb = fold_weights(model)
+    acts = Actuators(edges=np.asarray(actuator_edges), targets_deg=np.asarray(targets_deg))
+    opt = RigidOptions(check_rank=False)
+    why = []
+    for triangulated in (False, True):
+        try:
+            path = rigid_fold(
+                cp,
+                acts,
+                steps=1,
+                options=opt,
+                triangulated=triangulated,
+                fold_stiffness=w,
+                diagonal_stiffness=kb,
+            )
+        except BarhingeError as exc:
+            why.append(f"{'triangulated' if triangulated else 'rigid'} panels: {exc}")
+            continue
+        V = np.asarray(path.X[-1], float)
+        X = _node_coordinates(model, V)
+        X = _fit_supports(X, np.asarray(fixed, bool), np.asarray(fixed_target, float))
+        meta = path.meta
+        record = {
+            "predictor": "triangulated panels" if triangulated else "rigid panels",
+            "branch": meta.get("branch"),
+            "mirrored": bool(meta.get("mirrored", False)),
+            "sign_conflicts": list(meta.get("sign_conflicts", [])),
+            "free_dof": meta.get("free_dof"),
+            "events": list(meta.get("events", [])),
+        }
+        return FlatStart(X=X, record=record)
+    log.warning(
+        "no rigid fold predicts the first increment off the flat start (%s)", "; ".join(why)
+    )
+    return None
+
+
+def creases_against_assignment(
+    model: Any, fold_deg: np.ndarray, mirrored: bool = False, min_deg: float = 1.0
+) -> list[int]:
+    """Pattern edges assigned M or V whose fold angle ``fold_deg`` (n_edges,) degrees has the
+    other sign by more than ``min_deg`` (signs flipped as a whole when ``mirrored``)."""
+    asg = np.asarray(model.pattern.assignment)
+    want = np.where(asg == "V", 1.0, np.where(asg == "M", -1.0, 0.0))
+    if mirrored:
+        want = -want
+    f = np.asarray(fold_deg, float)
+    return np.flatnonzero(want * f < -min_deg).tolist()

@@ -1,0 +1,100 @@
+"""Fold from flat: the bar-and-hinge solver leaves the flat state on the branch the crease
+pattern asks for, and approaches the energy-minimising rigid fold as panels stiffen."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import barhinge as bh
+
+MAT = bh.Material(E=1e6, nu=0.3, t=0.01)
+
+
+def _against(cp, fold_deg, min_deg=1e-6):
+    asg = cp.assignment
+    want = np.where(asg == "V", 1.0, np.where(asg == "M", -1.0, 0.0))
+    return np.flatnonzero(want * fold_deg < -min_deg)
+
+
+def test_readme_example_folds_with_the_assignment():
+    """The README's Python example, started flat exactly as written: every crease folds with
+    its assignment's sign, nearly all the energy is in the folds (panels + bars < 1 % at
+    stiffness ratio 1e4), and the actuator reaches its target."""
+    cp = bh.patterns.miura(nx=4, ny=4, a=1.0, b=1.0, alpha=60.0)
+    a = bh.dof(cp).mechanism.actuators
+    model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=MAT, stiffness_ratio=1e4)
+    scene = bh.Scene(
+        model, actuators=bh.Actuators(edges=a, targets_deg=cp.fold_angles[a] / 2), steps=10
+    )
+    fp = bh.solve(scene)
+    assert fp.converged
+    assert len(_against(cp, fp.fold_angles_deg[-1])) == 0
+    share = 1.0 - fp.energy_fold[-1] / fp.energy[-1]
+    assert share < 0.01
+    np.testing.assert_allclose(fp.fold_angles_deg[-1, a], cp.fold_angles[a] / 2, atol=1e-6)
+    assert fp.meta["flat_start"]["predictor"] == "rigid panels"
+    assert fp.meta["branch_events"] == []
+
+
+def _rigid_gap(n, scheme, ratios, steps=6):
+    cp = bh.patterns.miura(nx=n, ny=n, a=1.0, b=1.0, alpha=60.0)
+    z = int(bh.patterns.miura_layout(n, n).interior_zigzag_edges[0])
+    target = 0.5 * cp.fold_angles[z]
+    rigid = bh.rigid_fold(cp, [z], targets_deg=[target], steps=steps).fold_angles_deg[-1]
+    errs = []
+    for ratio in ratios:
+        model = bh.BarHingeModel.from_pattern(
+            cp, scheme=scheme, material=MAT, stiffness_ratio=ratio
+        )
+        fp = bh.solve(
+            bh.Scene(model, actuators=bh.Actuators(edges=[z], targets_deg=[target]), steps=steps)
+        )
+        assert len(_against(cp, fp.fold_angles_deg[-1])) == 0
+        errs.append(float(np.abs(fp.fold_angles_deg[-1] - rigid).max()))
+    return np.asarray(errs)
+
+
+@pytest.mark.parametrize("n, scheme", [(2, "N5B8"), (3, "N5B8"), (3, "N4B5")])
+def test_bar_hinge_converges_to_the_rigid_fold_as_one_over_the_ratio(n, scheme):
+    """Rigid limit: with bars and panels `ratio` times stiffer, the fold angles differ from
+    the rigid kinematics (an independent solver in the crease angles) by O(1/ratio):
+    log-log slope -1 +- 0.15 over three decades."""
+    ratios = np.array([1e3, 1e4, 1e5])
+    errs = _rigid_gap(n, scheme, ratios)
+    slope = np.polyfit(np.log(ratios), np.log(errs), 1)[0]
+    assert abs(slope + 1.0) < 0.15, (errs, slope)
+
+
+@pytest.mark.slow
+def test_ten_by_ten_miura_from_flat_approaches_the_rigid_fold():
+    ratios = np.array([1e4, 1e5, 1e6])
+    errs = _rigid_gap(10, "N5B8", ratios, steps=5)
+    slope = np.polyfit(np.log(ratios), np.log(errs), 1)[0]
+    assert abs(slope + 1.0) < 0.15, (errs, slope)
+
+
+def test_flat_start_option_tangent_keeps_the_old_predictor():
+    cp = bh.patterns.miura(2, 2)
+    z = int(bh.patterns.miura_layout(2, 2).interior_zigzag_edges[0])
+    model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=MAT, stiffness_ratio=1e4)
+    acts = bh.Actuators(edges=[z], targets_deg=[0.5 * cp.fold_angles[z]])
+    fp = bh.solve(bh.Scene(model, actuators=acts, steps=4, options={"flat_start": "tangent"}))
+    assert fp.meta["flat_start"] is None
+    with pytest.raises(bh.ConfigError, match="flat_start"):
+        bh.Scene(model, actuators=acts, steps=4, options={"flat_start": "bogus"})
+
+
+def test_creases_against_the_assignment_are_an_event():
+    """A 6 x 6 Miura sheet with panels only 100 x stiffer than the default, driven by one
+    actuator: the panels bend and creases far from the actuator fold the other way; the run
+    names them (the count is checked against the assignment independently)."""
+    cp = bh.patterns.miura(6, 6)
+    z = int(bh.patterns.miura_layout(6, 6).interior_zigzag_edges[0])
+    model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=MAT, stiffness_ratio=100.0)
+    acts = bh.Actuators(edges=[z], targets_deg=[0.5 * cp.fold_angles[z]])
+    fp = bh.solve(bh.Scene(model, actuators=acts, steps=6))
+    bad = _against(cp, fp.fold_angles_deg[-1], min_deg=1.0)
+    assert len(bad) > 0
+    (ev,) = fp.meta["branch_events"]
+    assert ev.startswith(f"{len(bad)} crease(s) fold against their M/V assignment")
