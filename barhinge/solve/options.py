@@ -80,10 +80,11 @@ class SolverOptions:
         and the stability events). True: the tangent *at* the state is factorised (exact;
         one extra factorisation per state, except under arc length, whose next increment
         uses the same one). False: the count comes from the last factorisation Newton made
-        in the increment (free; the tangent one iteration before convergence, which differs
-        only at a state within round-off of a critical point; None when no factorisation
-        was made, e.g. with ``reuse_factorization``). None (default): True under load and
-        arc-length control, False under fold-angle and displacement control.
+        in the increment (free: the tangent one iterate before convergence), confirmed by a
+        factorisation at the state whenever it differs from the previous state's count or
+        is unknown (e.g. with ``reuse_factorization``): no false events, but a change may be
+        reported one step late. None (default): True under load and arc-length control,
+        False under fold-angle and displacement control.
     """
 
     tol_force: float = 1e-8
