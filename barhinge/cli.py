@@ -492,6 +492,7 @@ def fold_cmd(
         except ConvergenceError as exc:
             if exc.last_state is not None:
                 write_outputs(exc.last_state, scene, out)
+                _print_events(exc.last_state, err_console)
                 err_console.print(f"partial results ({exc.last_state.n_states} states) in {out}")
             raise
     files = write_outputs(path, scene, out)
@@ -518,6 +519,13 @@ def fold_cmd(
         t.add_row(k, v)
     t.add_row("output", str(out))
     console.print(t)
+    _print_events(path, console)
+
+
+def _print_events(path, to) -> None:
+    """The path's stability and work-balance events, one line each."""
+    for ev in path.meta.get("events", []):
+        to.print(f"event: {ev}", highlight=False, markup=False)
 
 
 # --- commands: render (results) ---

@@ -61,6 +61,7 @@ def summarize(
         "energy_bend": float(fold_path.energy_bend[-1]),
         "energy_fold": float(fold_path.energy_fold[-1]),
         "wall_time_s": float(fold_path.wall_time[-1]),
+        "events": [str(e) for e in fold_path.meta.get("events", [])],
     }
     if cp is not None and cp.n_faces >= 6:
         try:

@@ -412,6 +412,35 @@ class BorderedSystem:
             self.negative_pivots = neg() - offset if neg is not None else None
             self.inertia_seen.append(self.negative_pivots)
 
+    def tangent_negative_eigenvalues(self) -> int | None:
+        """Negative eigenvalues of the free-DOF tangent ``K_t = K_ff + sum mu_a H_a`` with the
+        actuators *released* (their moments held), from the last factorisation; None when
+        the backend's factor gives no inertia (SuperLU after off-diagonal pivoting).
+
+        Without actuators the factorised matrix is ``K_t`` itself. With actuators the
+        factorisation is of the bordered matrix ``B = [K_t G^T; G 0]`` (or of ``A = K_t +
+        p G^T G``, whose Schur complement adds ``In(-G A^-1 G^T)``; both congruent forms
+        have the inertia of B). Haynsworth's formula on ``K_t`` gives
+        ``In(B) = In(K_t) + In(Y)`` with ``Y = -(G K_t^-1 G^T)^-1``, the multiplier block of
+        ``B^-1``: ``n_act`` solves with the factorisation at hand (valid while K_t is
+        nonsingular, i.e. away from the critical point itself)."""
+        f, direct = self.factor, self.direct
+        neg = getattr(f, "negative_pivots", None)
+        if neg is None or direct is None:
+            return None
+        n_b = neg()
+        if n_b is None:
+            return None
+        if self.Gf is None:
+            return int(n_b)
+        na = self.Gf.shape[0]
+        if isinstance(direct, _DirectSolver):
+            S_inv = 0.5 * (direct.S_inv + direct.S_inv.T)  # (G A^-1 G^T)^-1
+            n_b += int(np.sum(np.linalg.eigvalsh(S_inv) > 0))
+        _, Y = direct.solve(np.zeros((len(self.free_idx), na)), np.eye(na))
+        Y = np.asarray(Y).reshape(na, na)
+        return int(n_b) - int(np.sum(np.linalg.eigvalsh(0.5 * (Y + Y.T)) < 0))
+
     def _keep(self, direct: _DirectSolver | _KKTSolver, t_start: float) -> None:
         """Make ``direct`` the factorisation of the current operator."""
         self.direct = direct

@@ -38,6 +38,11 @@ __all__ = ["Progress", "solve"]
 
 log = logging.getLogger(__name__)
 
+#: relative mismatch between the external work and the stored energy of a path above which
+#: an event is recorded (``meta["work_balance"]``); the Simpson work integration is third
+#: order, and the tests' coarsest paths (6-20 steps) stay below 1e-4 (docs/solver.md)
+WORK_TOLERANCE = 1e-3
+
 #: progress callback: (requested steps done, total steps, path parameter or load factor)
 Progress = Callable[[int, int, float], None]
 
@@ -102,7 +107,6 @@ class _Driver:
         self.records: list[dict[str, Any]] = []
         self.t_start = time.perf_counter()
         self.work = 0.0
-        self._last_sub: dict[str, Any] | None = None
         self._prev: _State | None = None
         self._prev2: _State | None = None
         self._retry_tangent = False  # next increment: tangent predictor (after a failure)
@@ -119,6 +123,10 @@ class _Driver:
         # (barhinge.solve.branch); its record says which branch was taken
         self._flat_start = bool(self.n_act and self.opts.flat_start == "rigid" and is_flat(model))
         self.flat_start_record: dict[str, Any] | None = None
+        # stability monitoring: inertia of the free-DOF tangent at every recorded state
+        self.exact_inertia = self.opts.exact_inertia(scene.control)
+        self._inc_serial = 0  # factorisations made before the current increment
+        self._arc_s = 0.0  # chord length along the arc-length path (work integration)
 
     # ------------------------------------------------------------ schedules
     def targets(self, t: float) -> np.ndarray:
@@ -368,6 +376,97 @@ class _Driver:
                 res,
             )
 
+    def _tangent_inertia(self, st: _State, e: _Eval, exact: bool) -> int | None:
+        """Negative eigenvalues of the free-DOF tangent at the converged state ``st``
+        (actuators released; :meth:`BorderedSystem.tangent_negative_eigenvalues`).
+
+        ``exact``: factorise the tangent at ``st`` (one factorisation). Otherwise the count
+        of the last factorisation Newton made since :attr:`_inc_serial` (the tangent one
+        iterate before convergence), None if there was none."""
+        if exact:
+            if e.ev.K is None:  # evaluated without the tangent (force-only)
+                e = self.evaluate(st)
+            try:
+                self.factorize(e, st)
+            except SingularMatrixError as exc:
+                log.debug("tangent at load factor %.6g not factorised: %s", st.lam, exc)
+                return None
+        elif self.timer.n_factorizations <= self._inc_serial:
+            return None
+        return self.system.tangent_negative_eigenvalues()
+
+    def _state_inertia(self, st: _State, e: _Eval) -> int | None:
+        """Inertia of a converged state for its record (option ``stability_check``): exact,
+        or the free count of the increment's last factorisation, confirmed by an exact one
+        when it differs from the previous state's (or is unknown). The iterate before
+        convergence can lie on the other side of a soft mode whose eigenvalue is small
+        against the tangent's change over one Newton correction (measured: -0.25 against
+        1.4e5 on a seeded degree-4 vertex), so an unconfirmed change would be a false
+        event; a true change the last iterate did not see is reported one step late."""
+        if self.exact_inertia:
+            return self._tangent_inertia(st, e, exact=True)
+        n = self._tangent_inertia(st, e, exact=False)
+        prev = next((r["neg"] for r in reversed(self.records) if r["neg"] is not None), None)
+        if n is None or n != prev:
+            return self._tangent_inertia(st, e, exact=True)
+        return n
+
+    def _stability_events(self) -> list[str]:
+        """Events where the free-DOF tangent's number of negative eigenvalues changes between
+        consecutive recorded states. Under arc length a change where the load factor has an
+        extremum is a limit point, one without a bifurcation (or the start of a
+        negative-stiffness branch); under the other controls it marks a negative-stiffness
+        branch entered or left."""
+        rec = self.records
+        lam = np.array([r["lam"] for r in rec])
+        known = [(i, r["neg"]) for i, r in enumerate(rec) if r.get("neg") is not None]
+        events = []
+        for (j, a), (i, b) in zip(known, known[1:], strict=False):
+            if a == b:
+                continue
+            change = f"negative eigenvalues of the tangent {a} -> {b}"
+            if self.scene.control == "arc_length":
+                win = lam[max(j - 1, 0) : i + 2]
+                d = np.diff(win)
+                d = d[d != 0]
+                turns = np.flatnonzero(np.sign(d[1:]) != np.sign(d[:-1]))
+                if turns.size and d[turns[0]] > 0:
+                    what, at = "limit point (load maximum)", float(win.max())
+                elif turns.size:
+                    what, at = "limit point (load minimum)", float(win.min())
+                else:
+                    what, at = "bifurcation (or negative-stiffness branch)", float(lam[i])
+                events.append(f"{what} at load factor {at:.6g} (state {i}: {change})")
+            else:
+                what = "entered" if b > a else "left"
+                where = f"step {i}" if i == j + 1 else f"between steps {j} and {i}"
+                events.append(
+                    f"negative-stiffness branch {what} at {where}, load factor "
+                    f"{lam[i]:.6g} ({change})"
+                )
+        return events
+
+    def _work_balance(self) -> tuple[dict[str, float], str | None]:
+        """External work against the change of stored energy over the recorded path; the
+        mismatch relative to the largest work or energy change met along the path (a path
+        that returns to a stress-free state has both near zero at its end)."""
+        rec = self.records
+        energy = np.array([r["eb"] + r["ebend"] + r["efold"] for r in rec])
+        works = np.array([r["work"] for r in rec])
+        work, de = float(works[-1]), float(energy[-1] - energy[0])
+        scale = float(max(np.abs(works).max(), np.abs(energy - energy[0]).max()))
+        # below the energy of the force floor over the model's size the two are round-off
+        floor = float(self.force_floor or 0.0) * self.size
+        rel = abs(work - de) / scale if scale > 0 and abs(work - de) > floor else 0.0
+        bal = {"work": work, "energy": de, "rel_mismatch": rel, "tolerance": WORK_TOLERANCE}
+        if rel <= WORK_TOLERANCE:
+            return bal, None
+        return bal, (
+            f"work balance: external work {work:.6g} against stored energy {de:.6g} "
+            f"(relative mismatch {rel:.2g} > {WORK_TOLERANCE:g}): steps too coarse for the "
+            "work integration, or a state off equilibrium"
+        )
+
     def _merit(self, e: _Eval) -> float:
         return float(e.r[self.free] @ e.r[self.free]) + float(
             (self.c_scale * e.c) @ e.c * self.c_scale
@@ -410,7 +509,11 @@ class _Driver:
             raise _Failed(f"singular tangent ({exc})", res) from None
 
     # ------------------------------------------------------------ records
-    def record(self, st: _State, e: _Eval, iters: int, res: list[float]) -> None:
+    def record(
+        self, st: _State, e: _Eval, iters: int, res: list[float], neg: int | None = None
+    ) -> None:
+        """Append the converged state ``st`` (``neg``: negative eigenvalues of its free-DOF
+        tangent, None if unknown)."""
         X = st.x.reshape(-1, 3)
         ev = e.ev
         R = np.zeros(self.n_dof)
@@ -432,20 +535,9 @@ class _Driver:
                 "res": tuple(res),
                 "wall": time.perf_counter() - self.t_start,
                 "work": self.work,
+                "neg": neg,
             }
         )
-
-    def add_work(self, prev: dict[str, Any], st: _State, e: _Eval) -> None:
-        """Trapezoidal work of loads, support reactions and actuators over one increment."""
-        x0 = prev["X"].ravel()
-        f0 = prev["lam"] * self.P + prev["R"].ravel()
-        R1 = np.zeros(self.n_dof)
-        R1[self.fixed] = e.r[self.fixed]
-        f1 = st.lam * self.P + R1
-        w = 0.5 * float((f0 + f1) @ (st.x - x0))
-        if self.n_act:
-            w += 0.5 * float((prev["moments"] + (-st.mu)) @ (e.terms.rho - prev["rho"]))
-        self.work += w
 
     def path(self, converged: bool = True, message: str = "") -> FoldPath:
         rec = self.records
@@ -464,6 +556,14 @@ class _Driver:
             "flat_start": self.flat_start_record,
             "branch_events": self.branch_events(),
         }
+        meta["negative_eigenvalues"] = [r.get("neg") for r in rec]
+        events = meta["branch_events"] + self._stability_events()
+        meta["work_balance"], unbalanced = self._work_balance()
+        if unbalanced:
+            events.append(unbalanced)
+        for ev in events:
+            log.warning("%s: %s", self.scene.name or "solve", ev)
+        meta["events"] = events
         return FoldPath(
             X=np.stack([r["X"] for r in rec]),
             fold_angles_deg=np.stack([r["fold"] for r in rec]),
@@ -518,7 +618,7 @@ class _Driver:
         o = self.opts
         steps = self.scene.steps
         st, e = self.initial()
-        self.record(st, e, 0, [])
+        self.record(st, e, 0, [], neg=self._tangent_inertia(st, e, exact=True))
         h0 = 1.0 / steps
         h = h0
         h_min = h0 * 0.5**o.max_cutbacks
@@ -529,6 +629,7 @@ class _Driver:
             while st.t < t_goal - 1e-12 * h0:
                 h_try = min(h, t_goal - st.t)
                 t1 = t_goal if h_try >= t_goal - st.t - 1e-12 * h0 else st.t + h_try
+                self._inc_serial = self.timer.n_factorizations
                 try:
                     new, e_new, res = self.increment(st, t1, t1)
                 except _Failed as f:
@@ -572,25 +673,10 @@ class _Driver:
                 res_all.extend(res)
                 if self.n_iter_last <= o.grow_iters:
                     h = min(2 * h_try, h0)
-            self.record(st, e_new, iters, res_all)
+            self.record(st, e_new, iters, res_all, neg=self._state_inertia(st, e_new))
             if progress is not None:
                 progress(s, steps, st.t)
         return self.path()
-
-    def _work_step(self, new: _State, e_new: _Eval) -> None:
-        """Add the work of the increment ending at ``new`` (from the last converged
-        increment, which may lie between requested steps)."""
-        last = self._last_sub if self._last_sub is not None else self.records[-1]
-        self.add_work(last, new, e_new)
-        R = np.zeros(self.n_dof)
-        R[self.fixed] = e_new.r[self.fixed]
-        self._last_sub = {
-            "X": new.x.reshape(-1, 3).copy(),
-            "lam": new.lam,
-            "R": R.reshape(-1, 3),
-            "moments": -new.mu,
-            "rho": e_new.terms.rho.copy(),
-        }
 
     def _work_sample(self, t: float, st: _State, e: _Eval) -> tuple[float, np.ndarray, np.ndarray]:
         """(t, q, F): generalised coordinates (x, actuator angles) and the forces doing work
@@ -601,10 +687,11 @@ class _Driver:
         F = np.concatenate([st.lam * self.P + R, -st.mu])
         return t, q, F
 
-    def _work_simpson(self, new: _State, e_new: _Eval) -> None:
+    def _work_simpson(self, new: _State, e_new: _Eval, s: float | None = None) -> None:
         """Work of the increment ending at ``new``: ``int F . dq`` with F and q interpolated
-        quadratically in t through the last three converged increments and Simpson's rule on
-        the last interval (exact for the cubic integrand: third-order accurate); the
+        quadratically in the path parameter (t, or ``s`` when given: the chord length under
+        arc length) through the last three converged increments and Simpson's rule on the
+        last interval (exact for the cubic integrand: third-order accurate); the
         trapezoidal rule on the first increment."""
         if not self._samples:
             st0 = _State(
@@ -621,7 +708,7 @@ class _Driver:
                     np.concatenate([st0.lam * self.P + R0, -st0.mu]),
                 )
             )
-        self._samples.append(self._work_sample(new.t, new, e_new))
+        self._samples.append(self._work_sample(new.t if s is None else s, new, e_new))
         self._samples = self._samples[-3:]
         if len(self._samples) == 2:
             (_, q0, F0), (_, q1, F1) = self._samples
@@ -644,7 +731,11 @@ class _Driver:
 
     def run_arc_length(self, progress: Progress | None) -> FoldPath:
         """MGDCM arc length (Leon et al. 2011): states at every increment until the load
-        factor reaches 1 (the last state is corrected to exactly 1 by load control)."""
+        factor reaches 1; the increment that passes 1 is replaced by a load-control
+        correction onto exactly 1 (from the state before it, else back from the state past
+        it). Raises ConvergenceError when an increment fails after its cut-backs, when the
+        step cap comes first, or when the landing on 1 fails: a path that did not reach
+        load factor 1 is never returned as converged."""
         o = self.opts
         steps = self.scene.steps
         max_steps = o.max_arc_steps or 10 * steps
@@ -657,14 +748,24 @@ class _Driver:
         n = 0
         while st.lam < 1.0 - 1e-12 and n < max_steps:
             n += 1
+            # the tangent at the converged state: its inertia for the record, and the
+            # factorisation of this increment's first attempt
+            e = self.evaluate(st)
+            try:
+                self.factorize(e, st)
+                factored = True
+                self.records[-1]["neg"] = self.system.tangent_negative_eigenvalues()
+            except SingularMatrixError:
+                factored = False  # the attempt raises its own failure
             scale = dl0
             for _cut in range(o.max_cutbacks + 1):
                 try:
                     new, e_new, res, tan, sgn = self._arc_increment(
-                        st, scale, first_tan, prev_tan, sign
+                        st, e, scale, first_tan, prev_tan, sign, factored
                     )
                     break
                 except _Failed as f:
+                    factored = False
                     scale /= 2
                     last = f
             else:
@@ -672,34 +773,58 @@ class _Driver:
             if first_tan is None:
                 first_tan = tan
             prev_tan, sign = tan, sgn
-            self._work_step(new, e_new)
-            if new.lam > 1.0 and st.lam < 1.0:
-                # land exactly on lambda = 1 by load control from the last state
-                try:
-                    fin, e_fin, res2 = self.increment(st, st.t, 1.0)
-                    self._last_sub = self.records[-1]
-                    self.work = self.records[-1]["work"]
-                    self._work_step(fin, e_fin)
-                    new, e_new, res = fin, e_fin, res2
-                except _Failed:
-                    pass
+            if new.lam >= 1.0 - 1e-12 and new.lam != 1.0:
+                new, e_new, res = self._land(st, new)
+            self._arc_s += float(np.linalg.norm(new.x - st.x))
+            self._work_simpson(new, e_new, s=self._arc_s)
             st = new
             self.record(st, e_new, len(res) + 1, res)
             if progress is not None:
-                progress(min(int(st.lam * steps), steps), steps, st.lam)
+                progress(min(max(int(st.lam * steps), 0), steps), steps, st.lam)
+        self.records[-1]["neg"] = self._tangent_inertia(st, e_new if n else e, exact=True)
+        if st.lam != 1.0:
+            msg = (
+                f"arc length stopped at its step cap (max_arc_steps = {max_steps}) at load "
+                f"factor {st.lam:.6g} of 1"
+            )
+            raise ConvergenceError(
+                msg, step=n, load_factor=st.lam, residuals=[],
+                last_state=self.path(converged=False, message=msg),
+            )  # fmt: skip
         return self.path()
 
-    def _arc_increment(self, st, dl0, first_tan, prev_tan, sign):
-        """One MGDCM increment: predictor with the GSP-scaled load increment, correctors
-        with ``dlambda = -(du_1 . du_bar)/(du_1 . du_hat)`` (Leon et al. 2011)."""
+    def _land(self, st: _State, past: _State) -> tuple[_State, _Eval, list[float]]:
+        """Correct onto load factor exactly 1 by load control: from ``st`` (below 1), else
+        from ``past`` (the arc-length state beyond 1) back. Raises ConvergenceError with the
+        path up to ``st`` when both fail."""
+        whys = []
+        for start in (st, past):
+            try:
+                return self.increment(start, start.t, 1.0)
+            except _Failed as f:
+                whys.append(f.why)
+        msg = (
+            f"arc length passed load factor 1 (from {st.lam:.6g} to {past.lam:.6g}) but the "
+            f"correction onto 1 failed ({whys[0]}; from the far side: {whys[1]})"
+        )
+        raise ConvergenceError(
+            msg, step=len(self.records), load_factor=st.lam, residuals=[],
+            last_state=self.path(converged=False, message=msg),
+        )  # fmt: skip
+
+    def _arc_increment(self, st, e, dl0, first_tan, prev_tan, sign, factored=False):
+        """One MGDCM increment from ``st`` (``e`` its evaluation; ``factored``: the system
+        holds the factorisation of its tangent): predictor with the GSP-scaled load
+        increment, correctors with ``dlambda = -(du_1 . du_bar)/(du_1 . du_hat)`` (Leon et
+        al. 2011)."""
         o = self.opts
         free = self.free
         res: list[float] = []
-        e = self.evaluate(st)
-        try:
-            self.factorize(e, st)
-        except SingularMatrixError as exc:
-            raise _Failed(f"singular tangent ({exc})", res) from None
+        if not factored:
+            try:
+                self.factorize(e, st)
+            except SingularMatrixError as exc:
+                raise _Failed(f"singular tangent ({exc})", res) from None
         zc = np.zeros(self.n_act)
         u_hat, mu_hat = self.system.solve(self.P[free], zc)
         sgn = gdcm_sign(prev_tan, u_hat, sign)

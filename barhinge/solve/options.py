@@ -72,7 +72,19 @@ class SolverOptions:
     arc_length_increment : float or None
         Load-factor increment of the first arc-length (MGDCM) step; default ``1/steps``.
     max_arc_steps : int or None
-        Cap on arc-length increments (default ``10 * steps``).
+        Cap on arc-length increments (default ``10 * steps``); a run that reaches it before
+        load factor 1 raises :class:`~barhinge.errors.ConvergenceError`.
+    stability_check : bool or None
+        How the inertia of the free-DOF tangent (its number of negative eigenvalues, actuators
+        released) is found at every recorded state (``FoldPath.meta["negative_eigenvalues"]``
+        and the stability events). True: the tangent *at* the state is factorised (exact;
+        one extra factorisation per state, except under arc length, whose next increment
+        uses the same one). False: the count comes from the last factorisation Newton made
+        in the increment (free: the tangent one iterate before convergence), confirmed by a
+        factorisation at the state whenever it differs from the previous state's count or
+        is unknown (e.g. with ``reuse_factorization``): no false events, but a change may be
+        reported one step late. None (default): True under load and arc-length control,
+        False under fold-angle and displacement control.
     flat_start : str
         How an actuated scene leaves a flat (singular) start, where the tangent predictor
         cannot see the folding mode: ``"rigid"`` (default) predicts the first increment by
@@ -98,6 +110,7 @@ class SolverOptions:
     arc_length_increment: float | None = None
     max_arc_steps: int | None = None
     flat_start: str = "rigid"
+    stability_check: bool | None = None
 
     def __post_init__(self) -> None:
         for name in ("tol_force", "tol_disp", "tol_angle", "divergence_ratio"):
@@ -126,6 +139,11 @@ class SolverOptions:
                 f"solver option reuse_factorization = {self.reuse_factorization!r}; "
                 "expected true or false"
             )
+        if not (self.stability_check is None or isinstance(self.stability_check, bool)):
+            raise ConfigError(
+                f"solver option stability_check = {self.stability_check!r}; "
+                "expected true, false or omitted"
+            )
         a = self.augmentation
         if not (a == "auto" or (isinstance(a, int | float) and a >= 0)):
             raise ConfigError(f"solver option augmentation = {a!r}; expected 'auto' or >= 0")
@@ -133,6 +151,13 @@ class SolverOptions:
     def reuses_factorization(self, control: str) -> bool:
         """Whether the solve under ``control`` reuses factorisations (see the option)."""
         return bool(self.reuse_factorization) and control != "arc_length"
+
+    def exact_inertia(self, control: str) -> bool:
+        """Whether the tangent is factorised at every recorded state under ``control``
+        (see ``stability_check``)."""
+        if self.stability_check is None:
+            return control in ("load", "arc_length")
+        return bool(self.stability_check)
 
     @classmethod
     def from_dict(cls, d: dict[str, Any] | None) -> SolverOptions:

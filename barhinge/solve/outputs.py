@@ -67,6 +67,10 @@ def summary(path: FoldPath, scene: Any = None) -> dict[str, Any]:
             "moment": path.actuator_moments[last].tolist(),
         },
         "timing": path.meta.get("timing", {}),
+        # stability events (limit points, bifurcations, negative-stiffness branches) and
+        # the work balance; see docs/solver.md
+        "events": list(path.meta.get("events", [])),
+        "work_balance": path.meta.get("work_balance"),
     }
     if path.reactions is not None:
         out["reaction_sum"] = path.reactions[last].sum(axis=0).tolist()

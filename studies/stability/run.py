@@ -91,6 +91,8 @@ def diagnose(exc: ConvergenceError, scene: bh.Scene) -> str:
         return "lock: a crease reaches +-180 deg (panels meet)"
     if "singular" in msg:
         return "singular tangent: bifurcation or unrestrained mechanism"
+    if "step cap" in msg:
+        return "step cap: the arc-length path did not reach load factor 1 (max_arc_steps)"
     path = exc.last_state
     X = path.X[-1] if path is not None else scene.model.X0
     free = ~scene.fixed.ravel()
@@ -143,6 +145,11 @@ def snap_load() -> Outcome:
     return out or Outcome("converged", "passed a limit point under load control (unexpected)")
 
 
+def _events(path) -> str:
+    """The solver's stability events of a path, for the table."""
+    return "; ".join(path.meta.get("events", [])) or "no events"
+
+
 def snap_arc() -> Outcome:
     path, out = _solve(_vm_load_scene("arc_length"))
     if out:
@@ -152,8 +159,33 @@ def snap_arc() -> Outcome:
     return Outcome(
         "converged",
         f"passed the limit point; peak {peak:.4f} P_max (closed form 1)",
-        detail=f"{path.n_states} states",
+        detail=f"{path.n_states} states; {_events(path)}",
         value=peak,
+    )
+
+
+def snap_arc_cap() -> Outcome:
+    """Arc length with too few increments for the whole path: must not report success."""
+    _, out = _solve(_vm_load_scene("arc_length").with_(options={"max_arc_steps": 20}))
+    return out or Outcome("converged", "reached load factor 1 within 20 arc steps")
+
+
+def roof_arc() -> Outcome:
+    """The Yoshimura roof of data/scenes at 30 times its weight: load control stops at a
+    limit point near 0.70 (not in the table: see snap-load); arc length passes it and a
+    bifurcation on the falling branch, and records both."""
+    base = bh.load_scene(ROOT / "data" / "scenes" / "yoshimura_roof.toml")
+    scene = base.with_(loads=30 * base.loads, control="arc_length", steps=10,
+                       options={"max_arc_steps": 80})  # fmt: skip
+    path, out = _solve(scene)
+    if out:
+        return out
+    ev = path.meta["events"]
+    ok = any(e.startswith("limit point") for e in ev) and path.load_factor[-1] == 1.0
+    return Outcome(
+        "converged" if ok else "failed",
+        f"through the snap-through to load factor 1; {len(ev)} events recorded",
+        detail=f"{path.n_states} states; {_events(path)}",
     )
 
 
@@ -232,7 +264,7 @@ def snapback_arc() -> Outcome:
         "followed the snap-back (controlled displacement reverses)"
         if back
         else "converged without a displacement reversal",
-        detail=f"{path.n_states} states",
+        detail=f"{path.n_states} states; {_events(path)}",
     )
 
 
@@ -316,9 +348,15 @@ def flat_barhinge(seed: bool) -> Outcome:
             f"creases {bad} fold against their assignment; seed an imperfection to choose",
         )
     if seed:
-        return Outcome("converged", "imperfection (2 deg along mode 2) selects the assigned branch")
+        return Outcome(
+            "converged",
+            "imperfection (2 deg along mode 2) selects the assigned branch",
+            detail=_events(path),
+        )
     return Outcome(
-        "converged", "rigid-fold predictor leaves the flat state on the assigned branch (mode 2)"
+        "converged",
+        "rigid-fold predictor leaves the flat state on the assigned branch (mode 2)",
+        detail=_events(path),
     )
 
 
@@ -371,6 +409,7 @@ def large_step(cutbacks: int) -> Outcome:
         f"one step with cut-backs; fold angles within {d:.1e} deg of a 20-step path"
         if ok
         else f"landed {d:.2f} deg away from the 20-step path (another branch)",
+        detail=_events(path),
     )
 
 
@@ -387,7 +426,17 @@ def soft_folds() -> Outcome:
         options={"max_cutbacks": 3},
     )
     path, out = _solve(scene)
-    return out or Outcome("converged", "soft folds converged")
+    if out:
+        return out
+    # folded, the Miura is a 1-DOF mechanism the actuator fixes: the rigid fold is the answer
+    rigid = bh.rigid_fold(cp, scene.actuators, steps=6).fold_angles_deg[-1]
+    d = float(np.max(np.abs(path.fold_angles_deg[-1] - rigid)))
+    if d > 1e-3:
+        return Outcome("failed", f"zero-stiffness folds: {d:.3g} deg from the rigid fold")
+    return Outcome(
+        "converged",
+        f"mechanism fixed by its actuator once folded; rigid fold to {d:.1e} deg",
+    )
 
 
 def stiff_folds() -> Outcome:
@@ -423,7 +472,9 @@ def barhinge_near_flat() -> Outcome:
     if out:
         return out
     return Outcome(
-        "converged", f"reached -178 deg ({int(path.iterations.sum())} Newton iterations)"
+        "converged",
+        f"reached -178 deg ({int(path.iterations.sum())} Newton iterations)",
+        detail=_events(path),
     )
 
 
@@ -439,6 +490,21 @@ SCENARIOS: list[Scenario] = [
         True,
     ),  # fmt: skip
     Scenario("snap-arc", "arc length", "snap-through (limit point)", "converged", snap_arc, True),
+    Scenario(
+        "snap-arc-cap",
+        "arc length",
+        "snap-through, max_arc_steps = 20",
+        "failed",
+        snap_arc_cap,
+        True,
+    ),  # fmt: skip
+    Scenario(
+        "roof-arc",
+        "arc length",
+        "Yoshimura roof, 30x weight (snap-through)",
+        "converged",
+        roof_arc,
+    ),  # fmt: skip
     Scenario("snapback-disp", "displacement control", "snap-back", "failed", snapback_disp, True),
     Scenario("snapback-arc", "arc length", "snap-back", "converged", snapback_arc),
     Scenario(
@@ -494,7 +560,9 @@ SCENARIOS: list[Scenario] = [
         "converged",
         lambda: large_step(8),
     ),  # fmt: skip
-    Scenario("soft-folds", "fold-angle control", "k_fold = 0 (Miura 2x2)", "failed", soft_folds),
+    Scenario(
+        "soft-folds", "fold-angle control", "k_fold = 0 (Miura 2x2)", "converged", soft_folds
+    ),
     Scenario(
         "stiff-folds",
         "fold-angle control",
