@@ -408,7 +408,7 @@ def _fold_form_rigid(scene, out: Path) -> tuple[object, dict] | None:
     t0 = time.perf_counter()
     try:
         # no DOF recount per state (a diagnostic that costs a dense SVD per state)
-        opts = RigidOptions(max_cutbacks=3, check_rank=False)
+        opts = RigidOptions(max_cutbacks=3, check_rank=False, over_actuated="error")
         # free motions resolved with the model's own fold springs (its rigid limit)
         weights, _ = fold_weights(scene.model)
         path = rigid_fold(

@@ -15,7 +15,7 @@ from pathlib import Path
 from barhinge.pattern.io import read
 from barhinge.pattern.validate import findings
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "crease-patterns"
+SHARED = Path(__file__).resolve().parents[1] / "tests" / "data" / "crease-patterns"
 FILES = [
     "origami-simulator/BoxPleatPyramid.fold",
     "origami-simulator/BoxPleatInOutWave.fold",

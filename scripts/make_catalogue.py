@@ -8,7 +8,7 @@ Usage::
 
 Generated patterns are written as FOLD files whose key frame is the flat pattern (with target
 fold angles) and, for families with an exact rigid folding, a second frame holding the folded
-state. Real patterns from ``../shared/crease-patterns`` are copied (SVG ones converted to FOLD)
+state. Real patterns from ``tests/data/crease-patterns`` are copied (SVG ones converted to FOLD)
 with their author, source and licence in the file metadata and in data/patterns/LICENSES.md.
 """
 
@@ -28,7 +28,7 @@ from barhinge.patterns import FAMILIES
 from barhinge.patterns.properties import degree_counts
 
 REPO = Path(__file__).resolve().parents[1]
-SHARED = REPO.parent / "shared" / "crease-patterns"
+SHARED = REPO / "tests" / "data" / "crease-patterns"
 OUT = REPO / "data" / "patterns"
 IMG = REPO / "docs" / "img" / "patterns"
 DOC = REPO / "docs" / "patterns.md"
@@ -214,7 +214,7 @@ def main(argv: list[str] | None = None) -> None:
         meta = dict(cp.meta)
         meta["file_author"] = meta.get("file_author") or source.split("(")[1].split(")")[0]
         meta["file_description"] = f"{source}; licence: MIT (see data/patterns/LICENSES.md)"
-        meta["barhinge:source"] = f"../shared/crease-patterns/{rel}"
+        meta["barhinge:source"] = f"tests/data/crease-patterns/{rel}"
         cp = cp.replaced(meta=meta)
         bh.write_fold(cp, OUT / f"{name}.fold")
         licences.setdefault(lic, []).append(f"`{name}.fold` from `{rel}`: {source}")
@@ -250,7 +250,7 @@ def _write_licences(licences: dict[str, list[str]]) -> None:
     ]
     for folder, items in licences.items():
         lic = (SHARED / folder / "LICENSE").read_text().strip()
-        lines += [f"## From `../shared/crease-patterns/{folder}/`", ""]
+        lines += [f"## From `tests/data/crease-patterns/{folder}/`", ""]
         lines += [f"- {it}" for it in items]
         lines += ["", "Licence of these files:", "", "```", lic, "```", ""]
     (OUT / "LICENSES.md").write_text("\n".join(lines))

@@ -7,12 +7,13 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
-SHARED_PATTERNS = REPO.parent / "shared" / "crease-patterns"
+#: real crease patterns drawn by others (Origami Simulator, FOLD spec), copied into the
+#: repository with their licences and sources (tests/data/crease-patterns/SOURCES.md)
+SHARED_PATTERNS = REPO / "tests" / "data" / "crease-patterns"
 
 
 @pytest.fixture(scope="session")
 def shared_patterns() -> Path:
-    """The folder of real crease patterns beside the repository (skip if absent)."""
-    if not SHARED_PATTERNS.is_dir():
-        pytest.skip(f"{SHARED_PATTERNS} is absent")
+    """The folder of real crease patterns kept with the tests."""
+    assert SHARED_PATTERNS.is_dir(), f"{SHARED_PATTERNS} is missing from the repository"
     return SHARED_PATTERNS

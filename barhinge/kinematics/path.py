@@ -88,6 +88,11 @@ class RigidOptions:
         is below this (radians).
     energy_max_iter : int
         Newton iterations of that minimisation per step.
+    over_actuated : str
+        Actuators whose targets no rigid fold can meet together: ``"least_squares"``
+        (default) meets them in least squares (the actuators become stiff springs to their
+        targets; the misfit per state is in ``path.meta["actuator_misfit_deg"]`` and an
+        event names the dependent actuators) or ``"error"`` (``ConfigError``).
     """
 
     tol: float = 1e-13
@@ -99,6 +104,17 @@ class RigidOptions:
     cg_maxiter: int = 25
     energy_tol: float = 1e-9
     energy_max_iter: int = 40
+    over_actuated: str = "least_squares"
+
+    def __post_init__(self) -> None:
+        if self.over_actuated not in ("least_squares", "error"):
+            raise ConfigError(
+                f"over_actuated = {self.over_actuated!r}; expected 'least_squares' or 'error'"
+            )
+
+
+class _Incompatible(ConfigError):
+    """Over-determining actuators with incompatible targets (linearised misfit)."""
 
 
 class _Singular(RuntimeError):
@@ -124,11 +140,16 @@ class RigidSolver:
         weights: np.ndarray | None = None,
     ) -> None:
         self.rc = rc
-        self.act = np.asarray(act_var, dtype=np.int64)
+        #: driven creases; ``act`` are those held at their targets (all of them, or none
+        #: once incompatible targets are met in least squares: see :meth:`make_soft`)
+        self.drive = np.asarray(act_var, dtype=np.int64)
+        self.act = self.drive.copy()
         self.opt = options
         free = np.ones(rc.n_var, bool)
         free[self.act] = False
         self.free = free
+        self.soft = False
+        self.targets_now = np.zeros(len(self.drive))
         #: fold-spring stiffness of each variable (moment per radian) and its rest angle
         self.weights = np.ones(rc.n_var) if weights is None else np.asarray(weights, dtype=float)
         self.rest = rc.rho0.copy()
@@ -280,6 +301,10 @@ class RigidSolver:
     def tangent(self, rho: np.ndarray, dt: np.ndarray) -> tuple[np.ndarray, float]:
         """Tangent step for actuator increments ``dt``: (rho_pred, relative misfit of the
         linearised constraints, > 0 when the actuators over-determine the motion)."""
+        if self.soft:  # least squares: the actuators move with their targets, then relax
+            out = rho.copy()
+            out[self.drive] += dt
+            return out, 0.0
         r, J = self.rc.evaluate(rho)
         self._factor(J)
         da = np.zeros(self.rc.n_var)
@@ -307,7 +332,7 @@ class RigidSolver:
         Returns the (possibly unconverged) result; the regular corrector finishes it.
         """
         d = _branch_direction(self.rc)
-        dA = d[self.act]
+        dA = d[self.drive]
         ok = np.abs(dA) > 1e-12
         if ok.any() and np.any(t_new != 0):
             s = float(np.median(t_new[ok] / dA[ok]))
@@ -329,7 +354,7 @@ class RigidSolver:
                 else 8.0 ** rng.uniform(-1.0, 1.0, self.rc.n_var)
             )
             x0 = rho + s * d * scale
-            x0[self.act] = t_new
+            x0[self.drive] = t_new
             x, rmax, conflicts = self._branch_lm(rho, x0, sgn)
             key = (len(conflicts) > 0, rmax)
             if best is None or key < best[0]:
@@ -392,10 +417,41 @@ class RigidSolver:
         return bool(float(np.max(np.abs(self.rc.residual(flat)), initial=0.0)) <= self.opt.tol)
 
     # ------------------------------------------------------------ free DOF: energy
+    def make_soft(self) -> None:
+        """Meet incompatible actuator targets in least squares from now on: the actuators
+        are released and pulled to their targets by springs ``soft_weight`` =
+        1e6 x the stiffest fold (the fold springs then only resolve what the targets leave
+        free)."""
+        self.soft = True
+        self.act = np.zeros(0, dtype=np.int64)
+        self.free = np.ones(self.rc.n_var, bool)
+        self._Dfree = sp.identity(self.rc.n_var, format="csr")
+        self._Dact = sp.csr_matrix((self.rc.n_var, self.rc.n_var))
+        self.underactuated = True
+        self._lu = None
+
+    @property
+    def soft_weight(self) -> float:
+        return 1e6 * float(self.weights.max(initial=1.0))
+
+    def _springs(self) -> tuple[np.ndarray, np.ndarray]:
+        """(weights, centres) of the quadratic energy ``1/2 sum w (rho - c)^2 + const``:
+        the fold springs, plus the actuator springs in least-squares mode."""
+        if not self.soft:
+            return self.weights, self.rest
+        w = self.weights.copy()
+        c = self.rest.copy()
+        d, ws = self.drive, self.soft_weight
+        c[d] = (w[d] * c[d] + ws * self.targets_now) / (w[d] + ws)
+        w[d] = w[d] + ws
+        return w, c
+
     def energy(self, rho: np.ndarray) -> float:
-        """Fold-spring energy ``1/2 sum w (rho - rho_rest)^2`` (moment x radian)."""
-        e = rho - self.rest
-        return 0.5 * float(self.weights @ (e * e))
+        """Fold-spring energy ``1/2 sum w (rho - rho_rest)^2`` (moment x radian), plus the
+        actuator springs in least-squares mode (up to a constant)."""
+        w, c = self._springs()
+        e = rho - c
+        return 0.5 * float(w @ (e * e))
 
     def minimize(self, rho: np.ndarray) -> tuple[np.ndarray, bool]:
         """Minimise the fold-spring energy over the free motions at fixed actuators.
@@ -415,13 +471,13 @@ class RigidSolver:
         """
         rc, free = self.rc, self.free
         fi = np.flatnonzero(free)
-        W = self.weights
+        W, centre = self._springs()
         delta = 1e-13 / float(W.max(initial=1.0))
         lam = None
         e0 = self.energy(rho)
         for _ in range(self.opt.energy_max_iter):
             r, J = rc.evaluate(rho)
-            g = W * (rho - self.rest)
+            g = W * (rho - centre)
             Jf = J[:, fi]
             Hf = sp.diags(W[fi])
             if lam is not None:
@@ -586,6 +642,7 @@ def rigid_fold(
     events: list[str] = []
     checked = False
     free_dof: int | None = None
+    soft_from: tuple[int, str] | None = None
     track: list[tuple[float, np.ndarray]] = [(0.0, rho.copy())]
 
     def dof_at(x: np.ndarray) -> int:
@@ -626,16 +683,43 @@ def rigid_fold(
             and not checked
             and not (np.max(np.abs(rho), initial=0.0) < FLAT_TOL)
         )
-        try:
-            ok, rho_new, over = _advance(
-                solver, rho, sched[s - 1], sched[s], opt, hist_all, track, check_misfit
+        least_squares = opt.over_actuated == "least_squares" and len(av) >= 2
+        while True:
+            try:
+                ok, rho_new, over = _advance(
+                    solver, rho, sched[s - 1], sched[s], opt, hist_all, track, check_misfit
+                )
+            except _Singular:
+                msg = (
+                    f"step {s}: the Jacobian of the free creases is singular (a bifurcation "
+                    f"point or actuators that leave free motions)"
+                )
+                raise failure(msg, s, hist_all) from None
+            except _Incompatible as exc:
+                if not least_squares:
+                    why = _dependent_actuators(rc, rho, av, act.edges)
+                    raise ConfigError(f"{exc}; {why}") from None
+                ok, soft_from = False, (s, str(exc).split(";")[0])
+            else:
+                flat_fail = not ok and np.max(np.abs(rho), initial=0.0) < FLAT_TOL
+                if not (flat_fail and least_squares and not solver.soft):
+                    break
+                soft_from = (s, "no rigid fold off the flat state meets the targets together")
+            # incompatible targets: meet them in least squares from this step on
+            solver.make_soft()
+            hist_all.clear()
+            del track[:-1]
+            check_misfit = False
+        if solver.soft and soft_from is not None and ok:
+            mis = np.degrees(rho_new[av] - sched[s])
+            ev = (
+                f"step {soft_from[0]}: actuator targets incompatible ({soft_from[1]}); met in "
+                f"least squares from here, misfit up to {np.max(np.abs(mis)):.3g} deg; "
+                f"{_dependent_actuators(rc, rho_new, av, act.edges)}"
             )
-        except _Singular:
-            msg = (
-                f"step {s}: the Jacobian of the free creases is singular (a bifurcation "
-                f"point or actuators that leave free motions)"
-            )
-            raise failure(msg, s, hist_all) from None
+            events.append(ev)
+            log.warning(ev)
+            soft_from = None
         if s == 1 and solver.mirrored and not solver.sign_conflicts:
             ev = (
                 "step 1: the actuator targets ask for the mirror image of the branch "
@@ -748,6 +832,7 @@ def _advance(
     over = -1
     while pending:
         a, b, depth = pending.pop()
+        solver.targets_now = np.asarray(b, dtype=float).copy()
         s_new = track[-1][0] + float(np.linalg.norm(b - a)) if track else 0.0
         flat = np.max(np.abs(cur), initial=0.0) < FLAT_TOL
         guess = None
@@ -757,10 +842,10 @@ def _advance(
             guess = _extrapolate(track, s_new)
         if guess is None:
             guess, misfit = solver.tangent(cur, b - a)
-            if misfit > 1e-6 and opt.check_actuators:
-                raise ConfigError(
+            if misfit > 1e-6 and opt.check_actuators and not solver.soft:
+                raise _Incompatible(
                     f"the actuators over-determine the motion and their targets are "
-                    f"incompatible (linearised misfit {misfit:.1e}); drive fewer creases"
+                    f"incompatible (linearised misfit {misfit:.1e})"
                 )
             check_misfit = False
             if len(track) >= 2 and track[-1][0] > track[-2][0]:
@@ -770,7 +855,7 @@ def _advance(
                 slope = (guess - r1) / h
                 c = (r0 - r1 - slope * h0) / h0**2
                 guess = guess + c * h * h
-        guess[solver.act] = b
+        guess[solver.drive] = b
         solver.last_guess = guess
         new, hist, ok = solver.corrector(guess)
         hist_all.extend(hist)
@@ -842,6 +927,28 @@ def _spring_weights(
     return w
 
 
+def _dependent_actuators(
+    rc: RigidConstraints, rho: np.ndarray, av: np.ndarray, edges: np.ndarray
+) -> str:
+    """Which actuators follow from the others at the folded state ``rho``: the rows of the
+    null-space basis at the actuators, ordered by QR with column pivoting; the first
+    ``rank`` are independent."""
+    import scipy.linalg as sla
+
+    ns = null_space(rc.jacobian(rho))
+    NA = ns.basis[av]
+    if NA.size == 0:
+        return f"the motion has no DOF left for the actuators {edges.tolist()}"
+    _, R, piv = sla.qr(NA.T, mode="economic", pivoting=True)
+    d = np.abs(np.diag(R))
+    r = int(np.sum(d > 1e-8 * max(d.max(initial=0.0), 1e-300)))
+    ind, dep = edges[piv[:r]].tolist(), edges[piv[r:]].tolist()
+    return (
+        f"the motion has {ns.basis.shape[1]} DOF and the actuators fix {r}: "
+        f"edges {dep} follow from edges {ind} (drive fewer creases or make their targets agree)"
+    )
+
+
 def _free_motions(rc: RigidConstraints, rho: np.ndarray, av: np.ndarray) -> int:
     """Number of motions the actuators ``av`` leave free at the folded state ``rho``:
     the DOF (nullity of the Jacobian) minus the rank of the actuator rows of its null
@@ -901,6 +1008,10 @@ def _make_path(
         "energy_iterations": solver.energy_iterations,
         "branch": ("target fold angles" if np.any(cp.fold_angles != 0) else "M/V assignment"),
         "mirrored": bool(solver.mirrored),
+        "actuator_misfit_deg": [
+            float(np.max(np.abs(np.degrees(r[solver.drive]) - t), initial=0.0))
+            for r, t in zip(R, np.degrees(sched[: len(R)]), strict=True)
+        ],
         "sign_conflicts": sorted(
             {int(rc.var_source_edge[v]) for v in solver.sign_conflicts} - {-1}
         ),

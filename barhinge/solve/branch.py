@@ -57,7 +57,8 @@ class FlatStart:
         What was chosen: ``predictor`` ("rigid panels" or "triangulated panels"),
         ``branch`` ("M/V assignment" or "target fold angles"), ``mirrored``,
         ``sign_conflicts`` (pattern edges against the branch signs), ``free_dof`` (motions
-        the actuators leave, resolved by the fold-spring energy), ``events``.
+        the actuators leave, resolved by the fold-spring energy), ``least_squares`` (the
+        actuator targets conflict and were met in least squares), ``events``.
     """
 
     X: np.ndarray
@@ -183,6 +184,7 @@ def rigid_prediction(
             "sign_conflicts": list(meta.get("sign_conflicts", [])),
             "free_dof": meta.get("free_dof"),
             "events": list(meta.get("events", [])),
+            "least_squares": bool(max(meta.get("actuator_misfit_deg", [0.0])) > 1e-9),
         }
         return FlatStart(X=X, record=record)
     log.warning(

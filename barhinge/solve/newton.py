@@ -241,7 +241,12 @@ class _Driver:
         prev = self._prev
         prev2 = self._prev2
         extrapolate = o.predictor in ("secant", "quadratic") and not self._retry_tangent
-        flat = self._flat_start and st.t == 0.0 and self._flat_prediction(st, t1, lam1)
+        flat = (
+            self._flat_start
+            and st.t == 0.0
+            and not self._retry_tangent
+            and self._flat_prediction(st, t1, lam1)
+        )
         if flat:
             new = flat
         elif prev is not None and prev.t < st.t and extrapolate:
@@ -647,6 +652,13 @@ class _Driver:
                                 f"{self._inertia} to {bad[0]} while iterating ({f.why}); use "
                                 "control = 'arc_length' to pass it"
                             )
+                    rec = self.flat_start_record or {}
+                    if st.t == 0.0 and rec.get("least_squares") and not self._retry_tangent:
+                        # the rigid fold could only meet the targets in least squares (the
+                        # actuators conflict): the panels must bend, and Newton may not
+                        # reach that from the rigid prediction; retry from the tangent
+                        self._retry_tangent = True
+                        continue
                     if (
                         not self._retry_tangent
                         and self._prev is not None

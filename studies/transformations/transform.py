@@ -85,7 +85,7 @@ def fold(cp, acts, steps: int):
 
     try:
         # over-determined actuators fail at the first step; 3 cut-backs tell that quickly
-        opts = RigidOptions(check_actuators=False, max_cutbacks=3)
+        opts = RigidOptions(check_actuators=False, max_cutbacks=3, over_actuated="error")
         path = bh.rigid_fold(cp, acts, steps=steps, options=opts)
         if path.converged:
             return path, None, None

@@ -1,4 +1,4 @@
-"""Every crease pattern in ../shared/crease-patterns is read, validated, written to FOLD and read
+"""Every crease pattern in tests/data/crease-patterns is read, validated, written to FOLD and read
 back equal; counts of several are checked against values counted independently."""
 
 from __future__ import annotations
