@@ -512,6 +512,12 @@ def fold_cmd(
     t.add_row("linear solver", str(info.get("linear_solver")))
     for k, v in info["energy"].items():
         t.add_row(f"energy {k}", f"{v:.6g}")
+    share = energy_share_text(path)
+    if share:
+        t.add_row("energy share", share)
+    flat = flat_start_text(path)
+    if flat:
+        t.add_row("flat start", flat)
     if info["actuators"]["moment"]:
         m = [abs(float(v)) for v in info["actuators"]["moment"]]
         t.add_row("max |actuator moment|", f"{max(m):.6g}")
@@ -520,6 +526,38 @@ def fold_cmd(
     t.add_row("output", str(out))
     console.print(t)
     _print_events(path, console)
+
+
+def _percent(x: float) -> str:
+    p = 100.0 * x
+    return f"{p:.1f} %" if p == 0.0 or abs(p) >= 0.1 else f"{p:.1g} %"
+
+
+def energy_share_text(path) -> str:
+    """The last state's energy split as one line ("folds 99.5 %, panel bending 0.4 %,
+    bars 0.1 %"); "" when the total is zero or unknown (rigid paths)."""
+    from barhinge.analysis.summary import energy_split
+
+    e = energy_split(path)
+    if e["energy_fraction_fold"] is None:
+        return ""
+    parts = (("folds", "fold"), ("panel bending", "bend"), ("bars", "bars"))
+    return ", ".join(f"{label} {_percent(e[f'energy_fraction_{k}'])}" for label, k in parts)
+
+
+def flat_start_text(path) -> str:
+    """``meta["flat_start"]`` as one line ("rigid panels, M/V assignment"); "" without it."""
+    rec = path.meta.get("flat_start")
+    if not rec:
+        return ""
+    words = [str(rec.get("predictor", "?"))]
+    if rec.get("branch"):
+        words.append(str(rec["branch"]))
+    if rec.get("mirrored"):
+        words.append("mirrored")
+    if rec.get("sign_conflicts"):
+        words.append(f"{len(rec['sign_conflicts'])} crease(s) against the branch signs")
+    return ", ".join(words)
 
 
 def _print_events(path, to) -> None:

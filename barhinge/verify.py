@@ -349,6 +349,110 @@ _miura_bh_case = Case(
     quick=False,
 )
 
+# 3 x 3 Miura sheet (a = b = 1, gamma = 60 deg) folded from flat to half its pattern target:
+# the zig-zag creases' target is 2 x 60 deg (bh.patterns.miura's default theta), half of it
+# is S&G's theta = 30 deg.
+_FS_N, _FS_THETA, _FS_RATIOS, _FS_STEPS = 3, 30.0, (1e4, 1e5), 6
+_FS_SG = _sg_closed_forms(1.0, 1.0, _MG, _FS_THETA)
+
+
+def _flat_start_gaps(fold_deg: np.ndarray, want: np.ndarray, lay) -> dict[str, np.ndarray]:
+    """Fold angles (n_edges,) degrees, signed by the M/V assignment ``want`` (+1 V, -1 M),
+    of the interior zig-zag and straight creases, and their gaps to the rigid closed forms."""
+    f = want * fold_deg
+    zz = f[lay.interior_zigzag_edges]
+    st = f[lay.interior_straight_edges]
+    return {
+        "zigzag": zz,
+        "straight": st,
+        "gap": np.abs(np.r_[zz - 2 * _FS_THETA, st - _FS_SG["rho_straight_deg"]]),
+    }
+
+
+def _multi_cell_flat_start(flat_start: str = "rigid") -> dict[str, float]:
+    """A 3 x 3 N5B8 Miura sheet started exactly flat, driven by one interior zig-zag crease to
+    half its pattern target in 6 steps, at stiffness ratios 1e4 and 1e5: creases against the
+    M/V assignment at any state of either run; at 1e5 the zig-zag and straight crease
+    farthest from the rigid closed forms; the observed order of the gap between the two
+    ratios. ``flat_start`` is the solver option (the tests show "tangent" fails the case)."""
+    import barhinge as bh
+
+    cp = bh.patterns.miura(_FS_N, _FS_N, alpha=_MG)
+    lay = bh.patterns.miura_layout(_FS_N, _FS_N)
+    ez = int(lay.interior_zigzag_edges[0])
+    target = 0.5 * float(cp.fold_angles[ez])
+    if abs(abs(target) - 2 * _FS_THETA) > 1e-9:
+        raise ValueError(f"half the pattern target is {target} deg, expected +-{2 * _FS_THETA}")
+    asg = np.asarray(cp.assignment)
+    want = np.where(asg == "V", 1.0, np.where(asg == "M", -1.0, 0.0))
+    against: set[int] = set()
+    gaps = {}
+    for ratio in _FS_RATIOS:
+        model = bh.BarHingeModel.from_pattern(
+            cp, scheme="N5B8", material=_material(), stiffness_ratio=ratio
+        )
+        scene = bh.Scene(
+            model,
+            actuators=bh.Actuators(edges=[ez], targets_deg=[target]),
+            steps=_FS_STEPS,
+            options={"flat_start": flat_start},
+        )
+        path = bh.solve(scene)
+        against.update(np.flatnonzero((want * path.fold_angles_deg < -1e-6).any(axis=0)))
+        gaps[ratio] = _flat_start_gaps(path.fold_angles_deg[-1], want, lay)
+    g = gaps[_FS_RATIOS[-1]]
+    zz, st = g["zigzag"], g["straight"]
+    return {
+        "creases_against_assignment": float(len(against)),
+        "rho_zigzag_deg": float(zz[np.argmax(np.abs(zz - 2 * _FS_THETA))]),
+        "rho_straight_deg": float(st[np.argmax(np.abs(st - _FS_SG["rho_straight_deg"]))]),
+        "gap_order": math.log10(
+            gaps[_FS_RATIOS[0]]["gap"].max() / gaps[_FS_RATIOS[1]]["gap"].max()
+        ),
+    }
+
+
+_FS_GAP = (
+    "stiffness ratio 1e5: bars and panels strain by O(1/ratio) (order checked by gap_order); "
+    "measured {:.1e} ({:.3f} deg); tolerance ~3x"
+)
+_flat_start_case = Case(
+    name="multi_cell_flat_start",
+    citation=(
+        f"{_SG_CITE} (rigid Miura: one folding mode with the M/V assignment of the sheet, "
+        "fold angles of every cell from theta); rigid-panel limit of Filipov, Liu, Tachi, "
+        "Schenk & Paulino 2017, IJSS 124:26"
+    ),
+    description=(
+        "bh.solve from the exact flat state, fold-angle control of one interior zig-zag crease "
+        "to half its pattern target (theta = 30 deg) in 6 steps; 3x3 Miura (gamma = 60 deg), "
+        "N5B8, Material(E=1e6, nu=0.3, t=0.01), stiffness ratios 1e4 and 1e5"
+    ),
+    compute=_multi_cell_flat_start,
+    quantities=(
+        Quantity(
+            "creases_against_assignment", 0.0, 0.0,
+            "integer count (fold angle against its M or V by > 1e-6 deg at any state of "
+            "either run): exact",
+            "sign(rho) = sign of the M/V assignment on all 60 creases",
+        ),
+        Quantity(
+            "rho_zigzag_deg", 2 * _FS_THETA, 2e-3, _FS_GAP.format(6.1e-4, 0.037),
+            "rho_z = 2 theta (the zig-zag crease farthest from it)",
+        ),
+        Quantity(
+            "rho_straight_deg", _FS_SG["rho_straight_deg"], 2e-3, _FS_GAP.format(7.1e-4, 0.023),
+            "tan(rho_s/2) = cos(gamma) tan(theta) (the straight crease farthest from it)",
+        ),
+        Quantity(
+            "gap_order", 1.0, 0.15,
+            "rigid-limit gap ~ 1/ratio; measured 0.998 (1e3..1e6: 0.983, 0.998, 0.9999)",
+            "log10(gap(1e4) / gap(1e5)) = 1, gap = max |rho - rho_SG| over all creases",
+        ),
+    ),
+    quick=False,
+)  # fmt: skip
+
 # generic flat-foldable degree-4 vertex: sector angles alpha, beta, pi - alpha, pi - beta
 _D4A, _D4B = 70.0, 50.0
 
@@ -830,6 +934,7 @@ CASES: dict[str, Case] = {
     for c in (
         _miura_rigid_case,
         _miura_bh_case,
+        _flat_start_case,
         _degree4_case,
         _maekawa_case,
         _curvature_case,

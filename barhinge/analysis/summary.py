@@ -4,6 +4,7 @@ writes into ``<name>_summary.json``."""
 from __future__ import annotations
 
 import logging
+import math
 from typing import Any
 
 import numpy as np
@@ -11,7 +12,7 @@ import numpy as np
 from barhinge.analysis.curvature import gaussian_curvature
 from barhinge.errors import BarhingeError
 
-__all__ = ["summarize"]
+__all__ = ["energy_split", "summarize"]
 
 log = logging.getLogger(__name__)
 
@@ -56,10 +57,7 @@ def summarize(
             float(fold_path.fold_angles_deg[-1, e]) for e in fold_path.actuator_edges
         ],
         "max_abs_fold_deg": float(np.abs(fold_path.fold_angles_deg[-1]).max(initial=0.0)),
-        "energy_total": float(fold_path.energy[-1]),
-        "energy_bars": float(fold_path.energy_bars[-1]),
-        "energy_bend": float(fold_path.energy_bend[-1]),
-        "energy_fold": float(fold_path.energy_fold[-1]),
+        **energy_split(fold_path),
         "wall_time_s": float(fold_path.wall_time[-1]),
         "events": [str(e) for e in fold_path.meta.get("events", [])],
     }
@@ -79,6 +77,31 @@ def summarize(
         L = np.linalg.norm(X[B[:, 1]] - X[B[:, 0]], axis=1)
         out["max_abs_bar_strain"] = float(np.abs(L / model.bar_L0 - 1).max(initial=0.0))
         out.update(_stiffness(model, X, fixed, loads, modes))
+    return out
+
+
+def energy_split(fold_path: Any, step: int = -1) -> dict[str, float | None]:
+    """Stored energy of one state split into folds, panel bending and bars.
+
+    Parameters
+    ----------
+    fold_path : FoldPath
+    step : int
+        State index (default: the last).
+
+    Returns
+    -------
+    dict with ``energy_total``, ``energy_fold``, ``energy_bend`` (panel bending hinges),
+    ``energy_bars`` and their fractions of the total ``energy_fraction_fold``,
+    ``energy_fraction_bend``, ``energy_fraction_bars`` (summing to 1; None when the total is
+    zero or unknown, as on a rigid path whose energies are NaN).
+    """
+    parts = {k: float(getattr(fold_path, f"energy_{k}")[step]) for k in ("bars", "bend", "fold")}
+    total = parts["bars"] + parts["bend"] + parts["fold"]  # as FoldPath.energy
+    out: dict[str, float | None] = {"energy_total": total}
+    out.update({f"energy_{k}": v for k, v in parts.items()})
+    known = math.isfinite(total) and total > 0.0
+    out.update({f"energy_fraction_{k}": v / total if known else None for k, v in parts.items()})
     return out
 
 
