@@ -330,8 +330,9 @@ class _Driver:
         """Events of the flat start: the rigid predictor's, and creases of the last state
         that fold against their M/V assignment."""
         rec = self.flat_start_record
-        if rec is None or not self.records:
+        if not self.records or not (self.n_act and is_flat(self.model)):
             return []
+        rec = rec or {}
         events = list(rec.get("events", []))
         bad = creases_against_assignment(
             self.model, self.records[-1]["fold"], mirrored=bool(rec.get("mirrored", False))

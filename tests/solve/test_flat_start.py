@@ -81,6 +81,10 @@ def test_flat_start_option_tangent_keeps_the_old_predictor():
     acts = bh.Actuators(edges=[z], targets_deg=[0.5 * cp.fold_angles[z]])
     fp = bh.solve(bh.Scene(model, actuators=acts, steps=4, options={"flat_start": "tangent"}))
     assert fp.meta["flat_start"] is None
+    # the plain tangent takes another branch here; the sign check still names it
+    bad = _against(cp, fp.fold_angles_deg[-1], min_deg=1.0)
+    assert len(bad) > 0
+    assert any(ev.startswith(f"{len(bad)} crease(s) fold against") for ev in fp.meta["events"])
     with pytest.raises(bh.ConfigError, match="flat_start"):
         bh.Scene(model, actuators=acts, steps=4, options={"flat_start": "bogus"})
 
