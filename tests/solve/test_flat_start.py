@@ -102,3 +102,28 @@ def test_creases_against_the_assignment_are_an_event():
     assert len(bad) > 0
     (ev,) = fp.meta["branch_events"]
     assert ev.startswith(f"{len(bad)} crease(s) fold against their M/V assignment")
+
+
+@pytest.mark.parametrize(
+    "cp", [bh.patterns.resch(3, 3), bh.patterns.waterbomb(3, 3)], ids=["resch", "waterbomb"]
+)
+def test_resch_and_waterbomb_fold_from_flat_and_name_what_they_do(cp):
+    """Resch and waterbomb sheets driven from flat by 1-3 of their suggested actuators:
+    the solve reaches the targets (or raises the package's ConvergenceError), and every
+    crease that folds against its assignment by more than 1 deg is named in an event."""
+    a_all = [int(e) for e in bh.dof(cp).mechanism.actuators]
+    for k in (1, 3):
+        a = a_all[:k]
+        model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=MAT, stiffness_ratio=1e4)
+        acts = bh.Actuators(edges=a, targets_deg=0.5 * cp.fold_angles[a])
+        try:
+            fp = bh.solve(bh.Scene(model, actuators=acts, steps=5))
+        except bh.ConvergenceError as exc:
+            assert str(exc) and exc.last_state is not None
+            continue
+        np.testing.assert_allclose(fp.fold_angles_deg[-1, a], 0.5 * cp.fold_angles[a], atol=1e-6)
+        bad = _against(cp, fp.fold_angles_deg[-1], min_deg=1.0)
+        named = [ev for ev in fp.meta["events"] if "fold against their M/V" in ev]
+        assert (len(bad) > 0) == (len(named) > 0)
+        if bad.size:
+            assert named[0].startswith(f"{len(bad)} crease(s)")
