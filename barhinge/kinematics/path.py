@@ -363,7 +363,24 @@ class RigidSolver:
                 break
         _, x, self.sign_conflicts = best
         self.branch_attempts = attempt + 1
+        self._flat_setup = (rho, s * d, sgn, np.asarray(t_new, dtype=float).copy())
         return x
+
+    def other_landings(self, n: int = 4) -> list[np.ndarray]:
+        """Further sign-consistent landings off the flat state of the last
+        :meth:`leave_flat` (rescaled guesses, other seeds): where the actuators leave free
+        motions, several folded branches match the signs and the one of least fold-spring
+        energy is wanted (the caller minimises each)."""
+        rho, sd, sgn, t_new = self._flat_setup
+        rng = np.random.default_rng(1)
+        out = []
+        for _ in range(n):
+            x0 = rho + sd * 8.0 ** rng.uniform(-1.0, 1.0, self.rc.n_var)
+            x0[self.drive] = t_new
+            x, rmax, conflicts = self._branch_lm(rho, x0, sgn)
+            if rmax <= 1e-6 and not conflicts:
+                out.append(x)
+        return out
 
     def _branch_lm(
         self, rho: np.ndarray, x: np.ndarray, sgn: np.ndarray
@@ -474,6 +491,7 @@ class RigidSolver:
         W, centre = self._springs()
         delta = 1e-13 / float(W.max(initial=1.0))
         lam = None
+        escapes = 0
         e0 = self.energy(rho)
         for _ in range(self.opt.energy_max_iter):
             r, J = rc.evaluate(rho)
@@ -500,7 +518,13 @@ class RigidSolver:
             dmax = float(np.max(np.abs(d), initial=0.0))
             log.debug("minimize: |d| %.3e, newton %s, E %.6e", dmax, lam is not None, e0)
             if dmax <= self.opt.energy_tol:
-                return rho, True
+                # a stationary point; Newton on the KKT conditions also converges to saddles,
+                # so leave along a direction of negative curvature when there is one
+                esc = self._escape_saddle(rho, lam_new, e0) if escapes < 8 else None
+                if esc is None:
+                    return rho, True
+                rho, e0, lam, escapes = esc, self.energy(esc), None, escapes + 1
+                continue
             if dmax > 0.5:
                 d *= 0.5 / dmax
             # line search on the energy, each trial projected back onto the manifold
@@ -519,6 +543,67 @@ class RigidSolver:
                 continue
             lam = lam_new
         return rho, False
+
+
+    def _escape_saddle(self, rho: np.ndarray, lam: np.ndarray, e0: float) -> np.ndarray | None:
+        """A lower-energy state near the stationary state ``rho`` (multipliers ``lam``) along
+        the most negative curvature of the Lagrangian on the tangent space of the free
+        creases, or None when that curvature is positive (a minimum) or the tangent space
+        is too large for a dense check (more than ``SADDLE_CHECK_MAX`` free creases)."""
+        import scipy.linalg as sla
+
+        fi = np.flatnonzero(self.free)
+        if len(fi) > SADDLE_CHECK_MAX:
+            return None
+        W, _ = self._springs()
+        J = self.rc.jacobian(rho)[:, fi].toarray()
+        Z = sla.null_space(J, rcond=1e-9)
+        if Z.shape[1] == 0:
+            return None
+        H = np.diag(W[fi]) + self.rc.multiplier_hessian(rho, lam)[fi][:, fi].toarray()
+        vals, vecs = np.linalg.eigh(Z.T @ H @ Z)
+        if vals[0] >= -1e-9 * float(np.abs(vals).max(initial=1.0)):
+            return None
+        v = np.zeros(self.rc.n_var)
+        v[fi] = Z @ vecs[:, 0]
+        v /= np.max(np.abs(v))
+        for step in (0.1, 0.03, 0.01, 0.003, 1e-3):
+            best = None
+            for sgn in (1.0, -1.0):
+                trial, _, ok = self.corrector(rho + sgn * step * v)
+                if ok and self.energy(trial) < e0 - 1e-12 * max(abs(e0), 1e-300):
+                    if best is None or self.energy(trial) < self.energy(best):
+                        best = trial
+            if best is not None:
+                log.debug("minimize: left a saddle (curvature %.3e)", vals[0])
+                return best
+        return None
+
+
+#: free creases up to which stationary states are checked for negative curvature (dense)
+SADDLE_CHECK_MAX = 2000
+
+
+def _least_energy_branch(solver: RigidSolver, first: np.ndarray) -> np.ndarray:
+    """Of the energy minima reached from several sign-consistent landings off the flat state
+    (``first`` among them), the one with fewest creases against the branch signs, then of
+    least fold-spring energy."""
+    _, _, sgn, _ = solver._flat_setup
+
+    def key(x: np.ndarray) -> tuple[int, float]:
+        size = max(float(np.max(np.abs(x), initial=0.0)), 1e-300)
+        return int(np.sum(sgn * x < -1e-6 * size)), solver.energy(x)
+
+    best, k_best = first, key(first)
+    for x in solver.other_landings():
+        cand, _, ok = solver.corrector(x)
+        if not ok:
+            continue
+        cand, ok = solver.minimize(cand)
+        k = key(cand)
+        if ok and (k[0] < k_best[0] or (k[0] == k_best[0] and k[1] < k_best[1] * (1 - 1e-9))):
+            best, k_best = cand, k
+    return best
 
 
 def _extrapolate(hist: list[tuple[float, np.ndarray]], s_new: float) -> np.ndarray | None:
@@ -873,6 +958,8 @@ def _advance(
                 new, ok = solver.minimize(new)
                 if not ok:
                     solver.energy_failed = True
+                elif flat and solver.free.sum() <= SADDLE_CHECK_MAX:
+                    new = _least_energy_branch(solver, new)
         if ok:
             cur = new
             track.append((s_new, new.copy()))

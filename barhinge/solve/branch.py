@@ -31,38 +31,17 @@ from barhinge.errors import BarhingeError
 from barhinge.model.triangulate import triangulate
 
 __all__ = [
-    "FlatStart",
+    "RigidGuide",
     "creases_against_assignment",
     "fold_weights",
     "is_flat",
-    "rigid_prediction",
+    "rigid_guide",
 ]
 
 log = logging.getLogger(__name__)
 
 #: a model whose fold hinges all lie within this of 0 rad starts flat
 FLAT_START_TOL = 1e-6
-
-
-@dataclasses.dataclass(frozen=True)
-class FlatStart:
-    """A predicted first state off the flat start and how it was chosen.
-
-    Attributes
-    ----------
-    X : (n_nodes, 3) float
-        Predicted node coordinates (supports at their prescribed positions where a rigid
-        motion can put them there).
-    record : dict
-        What was chosen: ``predictor`` ("rigid panels" or "triangulated panels"),
-        ``branch`` ("M/V assignment" or "target fold angles"), ``mirrored``,
-        ``sign_conflicts`` (pattern edges against the branch signs), ``free_dof`` (motions
-        the actuators leave, resolved by the fold-spring energy), ``least_squares`` (the
-        actuator targets conflict and were met in least squares), ``events``.
-    """
-
-    X: np.ndarray
-    record: dict[str, Any]
 
 
 def is_flat(model: Any) -> bool:
@@ -128,54 +107,95 @@ def _fit_supports(X: np.ndarray, fixed: np.ndarray, target: np.ndarray) -> np.nd
     return Y @ R.T + t
 
 
-def rigid_prediction(
+@dataclasses.dataclass(frozen=True)
+class RigidGuide:
+    """The rigid fold of a scene's whole actuator schedule, as node coordinates.
+
+    Attributes
+    ----------
+    X : (n_states, n_nodes, 3) float
+        Rigid-fold node coordinates at the requested steps that the rigid path reached
+        (state 0 = the flat start), each placed on the supports.
+    record : dict
+        What was chosen: ``predictor`` ("rigid panels" or "triangulated panels"),
+        ``branch`` ("M/V assignment" or "target fold angles"), ``mirrored``,
+        ``sign_conflicts`` (pattern edges against the branch signs), ``free_dof`` (motions
+        the actuators leave, resolved by the fold-spring energy), ``least_squares`` (the
+        actuator targets conflict and were met in least squares), ``events``, ``steps``
+        and ``t_max`` (path parameter the rigid fold reached).
+    """
+
+    X: np.ndarray
+    record: dict[str, Any]
+
+    @property
+    def t_max(self) -> float:
+        """Path parameter of the last state the rigid path reached (1 = the whole path)."""
+        return self.record["t_max"]
+
+    def at(self, t: float) -> np.ndarray:
+        """(n_nodes, 3) rigid-fold coordinates at path parameter ``t`` in [0, t_max],
+        linear between the requested steps."""
+        s = t * self.record["steps"]
+        i = min(int(np.floor(s)), len(self.X) - 2)
+        f = s - i
+        return (1.0 - f) * self.X[i] + f * self.X[i + 1]
+
+
+def rigid_guide(
     model: Any,
-    actuator_edges: np.ndarray,
-    targets_deg: np.ndarray,
+    actuators: Actuators,
+    steps: int,
     fixed: np.ndarray,
     fixed_target: np.ndarray,
-) -> FlatStart | None:
-    """Rigid-fold prediction of the state where the actuators reach ``targets_deg``.
+) -> RigidGuide | None:
+    """Rigid fold of the actuator schedule with the model's fold springs: the limit of the
+    bar-and-hinge model as bars and panels become rigid, on the branch of the M/V
+    assignment (see the module docstring).
 
     Parameters
     ----------
     model : BarHingeModel, flat in its reference state.
-    actuator_edges : (n_act,) int, pattern edge ids.
-    targets_deg : (n_act,) float, actuator fold angles of the predicted state (degrees,
-        valley > 0).
+    actuators : Actuators, the scene's (its schedule over ``steps`` requested steps).
+    steps : int, requested steps of the scene.
     fixed : (n_nodes, 3) bool, supported or prescribed components.
-    fixed_target : (n_nodes, 3) float, their positions at the predicted state.
+    fixed_target : (n_nodes, 3) float, their positions (at the start).
 
     Returns
     -------
-    FlatStart, or None when no rigid fold (with rigid or with triangulated panels) reaches
-    the targets; the reason is logged.
+    RigidGuide over the part of the schedule the rigid fold reached (at least one step), or
+    None when no rigid fold (with rigid or with triangulated panels) leaves the flat start;
+    the reason is logged.
     """
     # imported here: kinematics.path uses the solver's linear-algebra backends
+    from barhinge.errors import ConvergenceError
     from barhinge.kinematics.path import RigidOptions, rigid_fold
 
     cp = model.pattern
     w, kb = fold_weights(model)
-    acts = Actuators(edges=np.asarray(actuator_edges), targets_deg=np.asarray(targets_deg))
     opt = RigidOptions(check_rank=False)
     why = []
     for triangulated in (False, True):
         try:
             path = rigid_fold(
                 cp,
-                acts,
-                steps=1,
+                actuators,
+                steps=steps,
                 options=opt,
                 triangulated=triangulated,
                 fold_stiffness=w,
                 diagonal_stiffness=kb,
             )
+        except ConvergenceError as exc:
+            path = exc.last_state
+            if path is None or path.n_states < 2:
+                why.append(f"{'triangulated' if triangulated else 'rigid'} panels: {exc}")
+                continue
         except BarhingeError as exc:
             why.append(f"{'triangulated' if triangulated else 'rigid'} panels: {exc}")
             continue
-        V = np.asarray(path.X[-1], float)
-        X = _node_coordinates(model, V)
-        X = _fit_supports(X, np.asarray(fixed, bool), np.asarray(fixed_target, float))
+        fx, ft = np.asarray(fixed, bool), np.asarray(fixed_target, float)
+        X = np.stack([_fit_supports(_node_coordinates(model, V), fx, ft) for V in path.X])
         meta = path.meta
         record = {
             "predictor": "triangulated panels" if triangulated else "rigid panels",
@@ -185,8 +205,10 @@ def rigid_prediction(
             "free_dof": meta.get("free_dof"),
             "events": list(meta.get("events", [])),
             "least_squares": bool(max(meta.get("actuator_misfit_deg", [0.0])) > 1e-9),
+            "steps": int(steps),
+            "t_max": (path.n_states - 1) / steps,
         }
-        return FlatStart(X=X, record=record)
+        return RigidGuide(X=X, record=record)
     log.warning(
         "no rigid fold predicts the first increment off the flat start (%s)", "; ".join(why)
     )

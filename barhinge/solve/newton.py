@@ -21,7 +21,7 @@ import numpy as np
 
 from barhinge.errors import ConfigError, ConvergenceError
 from barhinge.results import FoldPath
-from barhinge.solve.branch import creases_against_assignment, is_flat, rigid_prediction
+from barhinge.solve.branch import RigidGuide, creases_against_assignment, is_flat, rigid_guide
 from barhinge.solve.controls import (
     BorderedSystem,
     Timer,
@@ -123,6 +123,7 @@ class _Driver:
         # (barhinge.solve.branch); its record says which branch was taken
         self._flat_start = bool(self.n_act and self.opts.flat_start == "rigid" and is_flat(model))
         self.flat_start_record: dict[str, Any] | None = None
+        self._guide: RigidGuide | None = None
         # stability monitoring: inertia of the free-DOF tangent at every recorded state
         self.exact_inertia = self.opts.exact_inertia(scene.control)
         self._inc_serial = 0  # factorisations made before the current increment
@@ -241,14 +242,9 @@ class _Driver:
         prev = self._prev
         prev2 = self._prev2
         extrapolate = o.predictor in ("secant", "quadratic") and not self._retry_tangent
-        flat = (
-            self._flat_start
-            and st.t == 0.0
-            and not self._retry_tangent
-            and self._flat_prediction(st, t1, lam1)
-        )
-        if flat:
-            new = flat
+        guided = self._guided_prediction(st, t1, lam1)
+        if guided is not None:
+            new = guided
         elif prev is not None and prev.t < st.t and extrapolate:
             if o.predictor == "quadratic" and prev2 is not None and prev2.t < prev.t:
                 # Lagrange extrapolation through the last three converged states
@@ -306,23 +302,39 @@ class _Driver:
             new, e, alpha = self._line_search(new, e, dx, dmu, self._expects_convergence(res))
             dx_last = alpha * dx
 
-    def _flat_prediction(self, st: _State, t1: float, lam1: float) -> _State | None:
-        """Rigid-fold prediction of the first increment off the flat start (None when no
-        rigid fold reaches the targets; the tangent predictor is used then)."""
-        target = self.X0.ravel().copy()
-        target[self.fixed] = self.fixed_coords(t1)
-        pred = rigid_prediction(
-            self.model,
-            self.scene.actuators.edges,
-            np.degrees(self.targets(t1)),
-            self.fixed.reshape(-1, 3),
-            target.reshape(-1, 3),
-        )
-        if pred is None:
-            self.flat_start_record = {"predictor": "tangent (no rigid fold found)"}
+    def _guided_prediction(self, st: _State, t1: float, lam1: float) -> _State | None:
+        """Rigid-fold prediction of the increment to ``t1`` (None: use the usual predictor).
+
+        Off a flat start the first increment is always predicted by the rigid fold of the
+        schedule (:func:`barhinge.solve.branch.rigid_guide`). Where the actuators leave free
+        motions, the increments that follow are predicted along it too,
+        ``x = X_rigid(t1) + (x - X_rigid(t))``, so the model follows the branch of least
+        fold-spring energy that the rigid fold chose instead of the first equilibrium its
+        own extrapolation meets."""
+        if not self._flat_start or self._retry_tangent:
             return None
-        self.flat_start_record = pred.record
-        new = _State(pred.X.ravel().copy(), st.mu.copy(), lam1, t1)
+        if self._guide is None and self.flat_start_record is None:
+            target = self.X0.ravel().copy()
+            target[self.fixed] = self.fixed_coords(0.0)
+            self._guide = rigid_guide(
+                self.model,
+                self.scene.actuators,
+                self.scene.steps,
+                self.fixed.reshape(-1, 3),
+                target.reshape(-1, 3),
+            )
+            self.flat_start_record = (
+                self._guide.record
+                if self._guide is not None
+                else {"predictor": "tangent (no rigid fold found)"}
+            )
+        g = self._guide
+        if g is None or t1 > g.t_max + 1e-12:
+            return None
+        if st.t > 0.0 and not g.record.get("free_dof"):
+            return None
+        x = g.at(t1).ravel() + (st.x - g.at(st.t).ravel())
+        new = _State(x, st.mu.copy(), lam1, t1)
         new.x[self.fixed] = self.fixed_coords(t1)
         return new
 

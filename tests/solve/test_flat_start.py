@@ -127,3 +127,31 @@ def test_resch_and_waterbomb_fold_from_flat_and_name_what_they_do(cp):
         assert (len(bad) > 0) == (len(named) > 0)
         if bad.size:
             assert named[0].startswith(f"{len(bad)} crease(s)")
+
+
+@pytest.mark.parametrize("n, k", [(3, 1), (3, 2), (6, 2)])
+def test_underactuated_resch_converges_to_the_energy_minimising_rigid_fold(n, k):
+    """Ron Resch sheets driven from flat by fewer actuators than their DOF: the free motions
+    are resolved by the fold springs in both solvers, and the bar-and-hinge fold angles
+    approach the energy-minimising rigid fold (bh.rigid_fold with the model's fold
+    stiffnesses) as 1/ratio: log-log slope -1 +- 0.15. Tight force tolerances: the gap is
+    below 1e-5 deg at ratio 1e5, where the default tolerance's error on the soft modes would
+    dominate it."""
+    from barhinge.solve.branch import fold_weights
+
+    cp = bh.patterns.resch(n, n)
+    a = [int(e) for e in bh.dof(cp).mechanism.actuators][:k]
+    targets = 0.5 * cp.fold_angles[a]
+    ratios = np.array([1e3, 1e4, 1e5])
+    errs = []
+    for ratio in ratios:
+        model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=MAT, stiffness_ratio=ratio)
+        w, _ = fold_weights(model)
+        rigid = bh.rigid_fold(cp, a, targets_deg=targets, steps=5, fold_stiffness=w)
+        assert rigid.meta["free_dof"] > 0
+        acts = bh.Actuators(edges=a, targets_deg=targets)
+        opts = {"tol_force": 1e-13, "tol_disp": 1e-13}
+        fp = bh.solve(bh.Scene(model, actuators=acts, steps=5, options=opts))
+        errs.append(np.abs(fp.fold_angles_deg[-1] - rigid.fold_angles_deg[-1]).max())
+    slope = np.polyfit(np.log(ratios), np.log(errs), 1)[0]
+    assert abs(slope + 1.0) < 0.15, (errs, slope)
