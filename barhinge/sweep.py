@@ -30,7 +30,10 @@ A point's identity is a stable hash of its parameters (:func:`point_id`). A reru
 points that already have a record (``retry_failed=True`` reruns the failed ones), so an
 interrupted sweep resumes where it stopped. The client is the only writer and keys records by
 point id, so a point that Dask re-executes after a worker died still yields exactly one record.
-A point that raises records ``{"type", "message"}`` and the sweep goes on.
+A point that raises records ``{"type", "message"}`` and the sweep goes on; so does a point whose
+result holds NaN or an infinity (``NonFiniteResult``, naming the key) and a point that kills the
+worker running it (``KilledWorker``: every point Dask gives up on is run again alone, and only
+one that still kills its workers fails). Every JSON file written is strict JSON (no ``NaN``).
 """
 
 from __future__ import annotations
@@ -44,6 +47,7 @@ import importlib
 import itertools
 import json
 import logging
+import math
 import os
 import socket
 import sys
@@ -89,6 +93,35 @@ def _json_default(o: object) -> object:
 
 def _canonical(params: dict[str, Any]) -> str:
     return json.dumps(params, sort_keys=True, separators=(",", ":"), default=_json_default)
+
+
+def _dumps(obj: Any, **kw: Any) -> str:
+    """Strict JSON (ValueError on NaN or an infinity), numpy values converted."""
+    return json.dumps(obj, default=_json_default, allow_nan=False, **kw)
+
+
+def _non_finite(v: Any, where: str, found: list[str]) -> Any:
+    """``v`` (parsed JSON) with NaN and infinities replaced by None; each one found is
+    appended to ``found`` as ``"'<where>' is nan"``."""
+    if isinstance(v, float) and not math.isfinite(v):
+        found.append(f"'{where}' is {v}")
+        return None
+    if isinstance(v, dict):
+        return {k: _non_finite(x, f"{where}.{k}" if where else str(k), found) for k, x in v.items()}
+    if isinstance(v, list):
+        return [_non_finite(x, f"{where}[{i}]", found) for i, x in enumerate(v)]
+    return v
+
+
+def _check_finite(v: Any, where: str) -> None:
+    """ConfigError naming the first NaN or infinity in a study parameter."""
+    found: list[str] = []
+    _non_finite(v, "", found)
+    if found:
+        key, value = found[0][1:].split("' is ")
+        raise ConfigError(
+            f"study {where} {key} = {value}; expected finite numbers (records are strict JSON)"
+        )
 
 
 def point_id(params: dict[str, Any]) -> str:
@@ -148,6 +181,10 @@ class Study:
                 raise ConfigError(f"grid entry {k!r} must be a non-empty list, got {v!r}")
         if not isinstance(self.batch_size, int) or self.batch_size < 1:
             raise ConfigError(f"batch_size must be an integer >= 1, got {self.batch_size!r}")
+        _check_finite(self.grid, "[grid]")
+        _check_finite(self.fixed, "[fixed]")
+        for i, p in enumerate(self.points):
+            _check_finite(p, f"[[points]] {i}:")
 
     def expand(self) -> list[Point]:
         """All points: the grid product then the explicit points; repeats dropped."""
@@ -231,7 +268,15 @@ def _run_point(fn: Callable[..., Any], pid: str, params: dict[str, Any]) -> Reco
         res = fn(**params)
         if not isinstance(res, dict):
             res = {"value": res}
-        rec["result"] = json.loads(json.dumps(res, default=_json_default))
+        found: list[str] = []
+        rec["result"] = _non_finite(json.loads(json.dumps(res, default=_json_default)), "", found)
+        if found:  # kept as null; the point failed (a NaN is no result, and not strict JSON)
+            rec["status"] = "failed"
+            more = f" ({len(found)} non-finite values)" if len(found) > 1 else ""
+            rec["error"] = {
+                "type": "NonFiniteResult",
+                "message": f"result {', '.join(found[:3])}{more}; expected finite numbers",
+            }
     except Exception as exc:  # a failing point is recorded, the sweep goes on
         rec["status"] = "failed"
         rec["error"] = {"type": type(exc).__name__, "message": _one_line(exc)}
@@ -256,13 +301,15 @@ def run_batch(
     return [_run_point(fn, pid, params) for pid, params in batch]
 
 
-def _failed(pid: str, params: dict[str, Any], exc: BaseException) -> Record:
+def _failed(
+    pid: str, params: dict[str, Any], exc: BaseException, message: str | None = None
+) -> Record:
     return {
         "id": pid,
         "params": params,
         "status": "failed",
         "result": None,
-        "error": {"type": type(exc).__name__, "message": _one_line(exc)},
+        "error": {"type": type(exc).__name__, "message": message or _one_line(exc)},
         "elapsed_s": None,
         "worker": None,
         "finished_at": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
@@ -283,12 +330,18 @@ def _atomic_write(path: Path, text: str) -> None:
 def write_record(out: Path, rec: Record) -> Path:
     """Write ``points/<id>.json`` atomically (temporary file + rename)."""
     path = _points_dir(out) / f"{rec['id']}.json"
-    _atomic_write(path, json.dumps(rec, indent=1, default=_json_default))
+    _atomic_write(path, _dumps(rec, indent=1))
     return path
 
 
+def _no_constant(name: str) -> Any:
+    raise ValueError(f"{name} is not strict JSON")
+
+
 def read_records(out: str | Path) -> dict[str, Record]:
-    """All point records in an output folder, keyed by point id (unreadable files skipped)."""
+    """All point records in an output folder, keyed by point id (unreadable files skipped,
+    and so are records holding NaN or Infinity, which older versions wrote: a rerun runs those
+    points again)."""
     pdir = _points_dir(Path(out))
     recs: dict[str, Record] = {}
     if not pdir.is_dir():
@@ -297,8 +350,8 @@ def read_records(out: str | Path) -> dict[str, Record]:
         if f.name.startswith("."):
             continue
         try:
-            rec = json.loads(f.read_text())
-        except (OSError, json.JSONDecodeError) as exc:
+            rec = json.loads(f.read_text(), parse_constant=_no_constant)
+        except (OSError, ValueError) as exc:
             log.warning("ignoring unreadable record %s (%s); the point will be rerun", f, exc)
             continue
         if rec.get("id") == f.stem:
@@ -312,7 +365,7 @@ _MAX_CELL = 1000  # longer non-scalar results stay in the point records only
 def _cell(v: Any) -> Any:
     if v is None or isinstance(v, str | int | float | bool):
         return v
-    text = json.dumps(v, default=_json_default)
+    text = _dumps(v)
     return text if len(text) <= _MAX_CELL else "(see points/<id>.json)"
 
 
@@ -432,7 +485,7 @@ def _dask(
     workers: int | None,
     timeout_s: float,
 ) -> Iterator[list[Record]]:
-    from distributed import as_completed
+    from distributed import KilledWorker, as_completed
 
     with _dask_client(scheduler, workers, timeout_s=timeout_s) as client:
         futures = {}
@@ -443,12 +496,36 @@ def _dask(
                 run_batch, study.function, list(study.paths), batch, key=key, pure=False
             )
             futures[fut] = batch
+        suspects: list[tuple[str, dict[str, Any]]] = []
         for fut in as_completed(futures):
             batch = futures[fut]
             try:
                 recs = fut.result()
-            except Exception as exc:  # e.g. KilledWorker after repeated worker deaths
+            except KilledWorker:  # on a worker that died: the killer, or in its queue
+                suspects += batch
+                continue
+            except Exception as exc:  # e.g. a lost connection
                 recs = [_failed(pid, params, exc) for pid, params in batch]
+            yield recs
+        if suspects:
+            log.info("%d points were on workers that died; running them alone", len(suspects))
+        for pid, params in suspects:  # alone on the cluster: a death is this point's doing
+            fut = client.submit(
+                run_batch, study.function, list(study.paths), [(pid, params)],
+                key=f"barhinge-alone-{pid}-{tag}", pure=False,
+            )  # fmt: skip
+            try:
+                recs = fut.result()
+            except KilledWorker as exc:
+                n = int(getattr(exc, "allowed_failures", 0)) + 1
+                last = getattr(getattr(exc, "last_worker", None), "address", "unknown")
+                msg = (
+                    f"worker died (killed {n} time{'s' if n != 1 else ''}) running this point "
+                    f"alone; last worker {last}"
+                )
+                recs = [_failed(pid, params, exc, message=msg)]
+            except Exception as exc:
+                recs = [_failed(pid, params, exc)]
             yield recs
 
 
@@ -513,7 +590,7 @@ def run_study(
     for stale in pdir.glob(".*.tmp"):
         stale.unlink(missing_ok=True)
     spec = dataclasses.asdict(study) | {"out": str(out)}
-    _atomic_write(out / "study.json", json.dumps(spec, indent=1, default=_json_default))
+    _atomic_write(out / "study.json", _dumps(spec, indent=1))
 
     points = study.expand()
     known = read_records(out)

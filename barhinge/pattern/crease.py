@@ -133,7 +133,8 @@ class CreasePattern:
             from barhinge.pattern.validate import merged_arrays
 
             V, E, A, F, faces = merged_arrays(V, E, A, F, faces, merge_tol)
-        if faces is None:
+        faces_found = faces is None  # after the merge: faces of the merged graph
+        if faces_found:
             from barhinge.pattern.planar import planar_faces
 
             faces = planar_faces(V, E)
@@ -152,6 +153,7 @@ class CreasePattern:
         object.__setattr__(self, "fold_angles", _readonly(F))
         object.__setattr__(self, "faces", faces_t)
         object.__setattr__(self, "meta", dict(self.meta))
+        object.__setattr__(self, "_faces_found", faces_found)
         if validate:
             from barhinge.pattern.validate import check
 
@@ -169,6 +171,12 @@ class CreasePattern:
     @property
     def n_faces(self) -> int:
         return len(self.faces)
+
+    @property
+    def faces_found(self) -> bool:
+        """True when the faces were found from the planar graph (none were given); a repair
+        with ``merge_tol`` then finds them again from the merged graph."""
+        return bool(getattr(self, "_faces_found", False))
 
     @cached_property
     def vertices3d(self) -> np.ndarray:
@@ -395,10 +403,26 @@ class CreasePattern:
 
     # ------------------------------------------------------------ new objects
     def replaced(self, **changes: Any) -> CreasePattern:
-        """A copy with some fields replaced (e.g. ``vertices=X`` for another state)."""
+        """A copy with some fields replaced (e.g. ``vertices=X`` for another state).
+
+        Faces that were found from the planar graph stay marked as found; with ``merge_tol``
+        (and no new ``faces`` or ``vertices``) they are found again after the merge, so that
+        merging never leaves the faces of the unmerged graph (which can miss a face).
+        """
         kw = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         kw.update(changes)
-        return CreasePattern(**kw)
+        found = self.faces_found and "faces" not in changes
+        if (
+            found
+            and changes.get("merge_tol") is not None
+            and "vertices" not in changes
+            and self.is_flat
+        ):
+            kw["faces"] = None
+        new = CreasePattern(**kw)
+        if found:
+            object.__setattr__(new, "_faces_found", True)
+        return new
 
     def __repr__(self) -> str:
         counts = {a: int((self.assignment == a).sum()) for a in ASSIGNMENTS}

@@ -187,6 +187,7 @@ def fold_dict_to_pattern(
     where: str = "FOLD data",
     validate: bool = True,
     developable: bool | None = None,
+    merge_tol: float | None = None,
 ) -> CreasePattern:
     """Build a CreasePattern from a parsed FOLD dictionary (see :func:`read_fold`)."""
     fr = _frame(data, frame, where)
@@ -233,7 +234,7 @@ def fold_dict_to_pattern(
         if flipped:
             for k in FACE_DERIVED_KEYS:
                 meta.pop(k, None)
-    else:
+    if "faces_vertices" not in fr or merge_tol is not None:  # faces found or renumbered
         for k in FACE_DERIVED_KEYS:
             meta.pop(k, None)
     if developable is None:
@@ -247,7 +248,7 @@ def fold_dict_to_pattern(
     try:
         return CreasePattern(
             V, Ea, np.array(asg, dtype=object), F,
-            faces, developable=developable, meta=meta, validate=validate,
+            faces, developable=developable, meta=meta, validate=validate, merge_tol=merge_tol,
         )  # fmt: skip
     except PatternError as exc:
         raise PatternError(f"{where}: {exc}") from None
@@ -259,6 +260,7 @@ def read_fold(
     *,
     validate: bool = True,
     developable: bool | None = None,
+    merge_tol: float | None = None,
 ) -> CreasePattern:
     """Read a crease pattern (or one frame of it) from a FOLD file.
 
@@ -272,6 +274,9 @@ def read_fold(
         Run :func:`barhinge.pattern.validate.check` (set False for bent, non-rigid states).
     developable : bool, optional
         Override the file's ``barhinge:developable`` flag (default True).
+    merge_tol : float, optional
+        Merge vertices closer than this length (and drop the zero-length and duplicate edges
+        that result) *before* the faces are found, or renumber the file's faces.
 
     Returns
     -------
@@ -281,7 +286,7 @@ def read_fold(
     """
     data, where = _load(source)
     return fold_dict_to_pattern(
-        data, frame, where=where, validate=validate, developable=developable
+        data, frame, where=where, validate=validate, developable=developable, merge_tol=merge_tol
     )
 
 

@@ -456,6 +456,17 @@ def _face_findings(c: _Ctx) -> list[Finding]:
                     "warning",
                 )
             )
+    if cp.n_faces == 0:
+        if not m:
+            why = "no edges either; expected a crease pattern with faces"
+        elif cp.faces_found:
+            why = "its edges enclose no area; expected faces bounded by its edges"
+        else:
+            why = (
+                "the face list is empty (faces_vertices = []); expected faces bounded by its "
+                "edges (omit faces_vertices to have them found from the edges)"
+            )
+        out.append(Finding("no-faces", f"the pattern has {m} edges but no faces: {why}", None))
     deg = np.bincount(E.ravel(), minlength=n) if m else np.zeros(n, np.int64)
     iso = np.flatnonzero(deg == 0)
     if len(iso):
@@ -758,14 +769,18 @@ def merged_arrays(V, E, A, F, faces, tol: float | None):
 
 
 def merged(
-    cp: CreasePattern, tol: float | None = None, *, derive_faces: bool = False
+    cp: CreasePattern, tol: float | None = None, *, derive_faces: bool | None = None
 ) -> CreasePattern:
     """A repaired copy of ``cp``.
 
     Vertices closer than ``tol`` (default ``REL_TOL * size``) are merged and zero-length and
-    duplicate edges removed. The faces are renumbered (loops that collapse below three
-    vertices are dropped), or found again from the planar graph with ``derive_faces=True``
-    (flat patterns; a hole would then become a face).
+    duplicate edges removed, then the faces are settled: found again from the planar graph
+    of the merged pattern when ``derive_faces`` is True, or when it is None (default) and
+    ``cp``'s faces were found rather than given (:attr:`CreasePattern.faces_found`); the
+    given faces renumbered otherwise (loops that collapse below three vertices are
+    dropped). Finding faces needs a flat pattern, and turns a hole into a face.
     """
     tol = tol if tol is not None else REL_TOL * cp.size
+    if derive_faces is None:
+        derive_faces = cp.faces_found
     return cp.replaced(merge_tol=tol, faces=None if derive_faces else cp.faces)

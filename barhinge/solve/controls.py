@@ -530,23 +530,28 @@ class BorderedSystem:
         b = np.concatenate([rhs_x, s * rhs_c]) if na else np.asarray(rhs_x, float)
         if not np.any(b):
             return np.zeros(nf), np.zeros(na)
+        kmax = int(self.krylov_max)
+        if kmax < 1:  # no iterations allowed: the caller factorises (scipy >= 1.12 raises
+            return None  # UnboundLocalError for restart=0 or maxiter=0)
         count = [0]
 
         def cb(_r: float) -> None:
             count[0] += 1
-            if count[0] > self.krylov_max:
+            if count[0] > kmax:
                 raise _KrylovStalled
 
         try:
             # restarts re-check the true residual (scipy's inner test is on the
-            # preconditioned one); the callback caps the total of inner iterations
+            # preconditioned one); the callback caps the total of inner iterations.
+            # Keywords as in scipy >= 1.12 (rtol, atol, restart, maxiter = restart cycles,
+            # callback_type); restart and maxiter must be >= 1 (checked above).
             z, info = spla.gmres(
                 op,
                 b,
                 rtol=rtol,
                 atol=0.0,
-                restart=self.krylov_max,
-                maxiter=self.krylov_max,
+                restart=kmax,
+                maxiter=kmax,
                 M=M,
                 callback=cb,
                 callback_type="pr_norm",

@@ -186,3 +186,26 @@ def test_redundant_actuators_are_named_by_every_backend(name):
     )
     with pytest.raises(bh.ConvergenceError, match="actuators are redundant"):
         bh.solve(scene)
+
+
+def test_no_gmres_iterations_allowed_factorises_without_calling_gmres():
+    """``krylov_max = 0`` on a reused factorisation: scipy >= 1.12 fails inside ``gmres``
+    with ``restart=0`` or ``maxiter=0`` (UnboundLocalError in scipy 1.17), so the solve must
+    factorise the new operator instead of calling GMRES. The operator is reused (not stale)
+    by construction, independent of timing."""
+    K, terms, free, mu = _miura_system()
+    K2, terms2, _, _ = _miura_system(nudge=1e-5)
+    sysm = BorderedSystem(get_backend("superlu"), free, terms.dofs, Timer(), reuse=True)
+    sysm.set_operator(K, terms, mu, penalty=50.0)
+    sysm.krylov_max = 0
+    sysm.set_operator(K2, terms2, 1.01 * mu, penalty=50.0)  # no GMRES time yet: reused
+    assert not sysm.current_factored
+    nf, na = int(free.sum()), len(mu)
+    rng = np.random.default_rng(3)
+    rx, rc = rng.standard_normal(nf), rng.standard_normal(na)
+    dx, dmu = sysm.solve(rx, rc, rtol=1e-12)
+    assert sysm.current_factored and sysm.last_krylov_iters == 0
+    ref = np.linalg.solve(_dense_bordered(K2, terms2, free, 1.01 * mu), np.concatenate([rx, rc]))
+    np.testing.assert_allclose(
+        np.concatenate([dx, dmu]), ref, rtol=0, atol=1e-8 * np.abs(ref).max()
+    )
