@@ -145,7 +145,9 @@ def test_underactuated_resch_converges_to_the_energy_minimising_rigid_fold(n, k)
     ratios = np.array([1e3, 1e4, 1e5])
     errs = []
     for ratio in ratios:
-        model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=MAT, stiffness_ratio=ratio)
+        model = bh.BarHingeModel.from_pattern(
+            cp, scheme="N5B8", material=MAT, stiffness_ratio=ratio
+        )
         w, _ = fold_weights(model)
         rigid = bh.rigid_fold(cp, a, targets_deg=targets, steps=5, fold_stiffness=w)
         assert rigid.meta["free_dof"] > 0
