@@ -1,7 +1,9 @@
 """Command-line interface: ``barhinge fold | info | dof | patterns | study | render | verify``.
 
-The CLI owns the terminal: rich tables and progress bars. Library errors become one line on
-stderr and exit code 2 (bad input) or 3 (did not converge); ``--debug`` shows the traceback.
+The CLI owns the terminal: rich tables and progress bars. :func:`main` is its one error
+boundary: usage mistakes, library errors and unreadable/unwritable files become one line on
+stderr and exit code 2 (bad input) or 3 (did not converge); anything else is a bug (exit 70);
+``--debug`` shows the traceback.
 """
 
 from __future__ import annotations
@@ -107,6 +109,7 @@ def info(
 
     Exit code 2 when the pattern has validation errors (they are listed).
     """
+    from rich.markup import escape
     from rich.table import Table
 
     from barhinge.pattern.io import read
@@ -141,7 +144,7 @@ def info(
         console.print(t)
         style = {"error": "bold red", "warning": "yellow", "info": "cyan"}
         for f in found:
-            console.print(f"[{style[f.severity]}]{f.severity}[/] {f.code}: {f.message}",
+            console.print(f"[{style[f.severity]}]{f.severity}[/] {f.code}: {escape(f.message)}",
                           highlight=False, soft_wrap=True)  # fmt: skip
         if not found:
             console.print("[green]valid[/]: no findings")
@@ -300,11 +303,16 @@ def _dof_pattern(spec: str):
             f"{spec!r} is neither a file nor a pattern family; families: "
             f"{', '.join(sorted(patterns.FAMILIES))}"
         )
+    known = patterns.family_parameters(name)
     kw: dict[str, object] = {}
     for item in filter(None, args.split(",")):
         key, eq, val = item.partition("=")
-        if not eq:
+        if not eq or not key.strip():
             raise ConfigError(f"family argument {item!r} must be key=value")
+        if key.strip() not in known:
+            raise ConfigError(
+                f"{name}: unknown parameter {key.strip()!r}; expected one of {', '.join(known)}"
+            )
         try:
             kw[key.strip()] = json.loads(val)
         except json.JSONDecodeError:
@@ -416,7 +424,7 @@ def _fold_form_rigid(scene, out: Path) -> tuple[object, dict] | None:
         )
     except BarhingeError as exc:
         err_console.print(f"rigid kinematics cannot fold it ({exc}); using the bar-and-hinge model",
-                          highlight=False, soft_wrap=True)  # fmt: skip
+                          highlight=False, markup=False, soft_wrap=True)  # fmt: skip
         return None
     out.mkdir(parents=True, exist_ok=True)
     files = [path.save(out / "fold_path.npz"), write_fold_path(cp, path, out / "fold_path.fold")]
@@ -589,6 +597,33 @@ def _pattern_for(result: Path, pattern: Path | None):
     )
 
 
+def _load_fold_path(result: Path):
+    """``FoldPath.load(result)``; a file that is not a saved fold path (empty, truncated,
+    another .npz or no .npz at all) becomes one ConfigError naming it."""
+    import pickle
+    import zipfile
+
+    from barhinge.errors import ConfigError
+    from barhinge.results import FoldPath
+
+    try:
+        return FoldPath.load(result)
+    except (
+        EOFError,  # empty file
+        zipfile.BadZipFile,  # truncated .npz
+        pickle.UnpicklingError,
+        KeyError,  # another .npz: no __json__ or a missing array
+        ValueError,  # not .npy/.npz, bad JSON, arrays of the wrong shape
+        TypeError,  # a .npy (no archive), unknown fields
+        AttributeError,
+        IndexError,
+    ) as exc:
+        why = f"{type(exc).__name__}: {_one_line(exc)}" if str(exc) else type(exc).__name__
+        raise ConfigError(
+            f"{result} is not a fold path saved by barhinge fold (.npz with __json__): {why}"
+        ) from None
+
+
 @app.command()
 def render(
     result: Annotated[Path, typer.Argument(help="Saved fold path (.npz from barhinge fold).")],
@@ -613,12 +648,18 @@ def render(
     from barhinge.results import FoldPath
 
     if not result.is_file():
-        raise ConfigError(f"result file {result} does not exist")
-    fp = FoldPath.load(result)
+        what = "is a folder, not a file" if result.is_dir() else "does not exist"
+        raise ConfigError(f"result file {result} {what}")
+    fp = _load_fold_path(result)
     cp = _pattern_for(result, pattern)
     if fp.X.shape[1] < cp.n_vertices:
         raise ConfigError(
             f"the path has {fp.X.shape[1]} nodes, but the pattern has {cp.n_vertices} vertices"
+        )
+    if fp.fold_angles_deg.shape[1] != cp.n_edges:
+        raise ConfigError(
+            f"the path has fold angles of {fp.fold_angles_deg.shape[1]} edges, but the pattern "
+            f"{pattern or 'beside it'} has {cp.n_edges} edges: not the pattern of {result.name}"
         )
     n = fp.n_states
     if not -n <= step < n:
@@ -663,12 +704,13 @@ def study(
         str | None, typer.Option("--scheduler", help="Dask scheduler address, tcp://HOST:PORT.")
     ] = None,
     workers: Annotated[
-        int | None, typer.Option("--workers", help="Worker processes of the local cluster.")
+        int | None,
+        typer.Option("--workers", min=1, help="Worker processes of the local cluster."),
     ] = None,
     serial: Annotated[bool, typer.Option("--serial", help="Run in this process.")] = False,
     out: Annotated[Path | None, typer.Option("--out", help="Output folder.")] = None,
     batch_size: Annotated[
-        int | None, typer.Option("--batch-size", help="Points per Dask task.")
+        int | None, typer.Option("--batch-size", min=1, help="Points per Dask task.")
     ] = None,
     retry_failed: Annotated[
         bool, typer.Option("--retry-failed", help="Rerun points that failed before.")
@@ -834,26 +876,96 @@ def verify_cmd(
         raise SystemExit(1)
 
 
-def main() -> None:
-    """Entry point: run the app, turning barhinge errors into one line and an exit code."""
+#: Exit codes of ``barhinge`` (README "Conventions"; docs/index.md "Errors").
+EXIT_OK, EXIT_BAD_INPUT, EXIT_NOT_CONVERGED, EXIT_INTERNAL = 0, 2, 3, 70  # 70: EX_SOFTWARE
+
+_REPORT = (
+    "this is a bug in barhinge: please report it with the command line, its input files and "
+    "the traceback that `barhinge --debug COMMAND ...` prints"
+)
+
+
+def _one_line(text: object) -> str:
+    """``text`` on one line (line breaks become spaces)."""
+    return " ".join(part.strip() for part in str(text).splitlines() if part.strip())
+
+
+def _say(line: str) -> None:
+    """One line on stderr, printed as is (no rich markup: ``[model]`` stays ``[model]``)."""
+    sys.stderr.write(line + "\n")
+    sys.stderr.flush()
+
+
+def _is_usage_error(exc: BaseException) -> bool:
+    """A command-line usage error, whatever its class: click's own, or the copies that
+    typer >= 0.29 bundles (``typer._click``); both carry ``exit_code`` and
+    ``format_message()``."""
+    return isinstance(getattr(exc, "exit_code", None), int) and callable(
+        getattr(exc, "format_message", None)
+    )
+
+
+def _usage_text(exc: BaseException) -> str:
+    msg = _one_line(exc.format_message())  # type: ignore[attr-defined]
+    ctx = getattr(exc, "ctx", None)
+    path = getattr(ctx, "command_path", None)
+    return f"{msg} (see '{path} --help')" if path else msg
+
+
+def _os_error_text(exc: OSError) -> str:
+    """An OS error naming its file(s): "out/x: Not a directory"."""
+    if exc.filename is None:
+        return _one_line(exc)
+    text = f"{exc.filename}: {exc.strerror or type(exc).__name__}"
+    if exc.filename2 is not None:
+        text += f" (and {exc.filename2})"
+    return _one_line(text)
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point, the CLI's one error boundary (``argv``: the arguments; default
+    ``sys.argv[1:]``).
+
+    Exits 0 when done; 2 with one line ``error: ...`` on stderr for bad input (usage errors,
+    ``BarhingeError``, unreadable or unwritable files); 3 when a solve did not converge
+    (partial results are written first); 70 with one line ``internal error: ...`` for
+    anything else, which is a bug. ``--debug`` re-raises, showing the traceback.
+    """
+    _state["debug"] = False  # set by the --debug callback; reset for in-process calls
     try:
-        code = app(standalone_mode=False)  # returns the code of a typer.Exit
-    except SystemExit:  # typer/click exits (help, usage)
+        code = app(args=argv, prog_name="barhinge", standalone_mode=False)
+    except SystemExit:  # typer.Exit / sys.exit inside a command: its code stands
         raise
+    except KeyboardInterrupt:
+        _say("interrupted")
+        sys.exit(130)
     except BarhingeError as exc:
         if _state["debug"]:
             raise
-        err_console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
-        sys.exit(3 if isinstance(exc, ConvergenceError) else 2)
-    except Exception as exc:  # click usage errors carry their own exit code
-        import click
-
-        if isinstance(exc, click.exceptions.ClickException):
-            exc.show()
-            sys.exit(exc.exit_code)
-        if isinstance(exc, click.exceptions.Abort):
+        _say(f"error: {_one_line(exc)}")
+        sys.exit(EXIT_NOT_CONVERGED if isinstance(exc, ConvergenceError) else EXIT_BAD_INPUT)
+    except OSError as exc:  # missing, unreadable or unwritable files and folders
+        if _state["debug"]:
+            raise
+        _say(f"error: {_os_error_text(exc)}")
+        sys.exit(EXIT_BAD_INPUT)
+    except Exception as exc:
+        if type(exc).__name__ == "NoArgsIsHelpError":  # bare ``barhinge``: the help
+            text = exc.format_message()  # type: ignore[attr-defined]
+            if text.strip():  # (typer's rich help prints itself and leaves this empty)
+                sys.stdout.write(text.rstrip("\n") + "\n")
+            sys.exit(EXIT_BAD_INPUT)
+        if _is_usage_error(exc):
+            _say(f"error: {_usage_text(exc)}")
+            sys.exit(EXIT_BAD_INPUT)
+        if type(exc).__name__ == "Abort":  # click's or typer's (EOF at a prompt)
+            _say("aborted")
             sys.exit(1)
-        raise
+        if _state["debug"]:
+            raise
+        what = f"{type(exc).__name__}: {_one_line(exc)}" if str(exc) else type(exc).__name__
+        _say(f"internal error: {what}; {_REPORT}")
+        sys.exit(EXIT_INTERNAL)
     if isinstance(code, int) and code != 0:
         sys.exit(code)
 
