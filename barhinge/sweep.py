@@ -210,11 +210,21 @@ def load_study(path: str | Path) -> Study:
     """Read a study TOML (see the module docstring); relative paths are taken from its folder."""
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise ConfigError(f"study file {path} does not exist") from None
+    except IsADirectoryError:
+        raise ConfigError(f"study file {path} is a folder; expected a TOML file") from None
+    except UnicodeDecodeError:
+        raise ConfigError(f"study file {path} is not text (UTF-8 TOML expected)") from None
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"study file {path} is not valid TOML: {exc}") from None
+    for key, kind in (("study", dict), ("grid", dict), ("fixed", dict), ("points", list)):
+        if key in data and not isinstance(data[key], kind):
+            what = "a table" if kind is dict else "an array of tables"
+            raise ConfigError(
+                f"study file {path}: {key} = {data[key]!r}; expected {what} ([{key}])"
+            )
     unknown = set(data) - _TOP_KEYS
     if unknown:
         raise ConfigError(
@@ -229,6 +239,22 @@ def load_study(path: str | Path) -> Study:
         )
     if "function" not in st:
         raise ConfigError(f"study file {path}: [study] needs function = 'module:function'")
+    if not isinstance(st["function"], str) or st["function"].count(":") != 1:
+        raise ConfigError(
+            f"study file {path}: [study] function = {st['function']!r}; "
+            "expected 'module:function'"
+        )
+    if not all(isinstance(p, dict) for p in data.get("points", [])):
+        raise ConfigError(f"study file {path}: every [[points]] entry must be a table")
+    for key in ("paths",):
+        v = st.get(key, [])
+        if not (isinstance(v, list) and all(isinstance(p, str) for p in v)):
+            raise ConfigError(
+                f"study file {path}: [study] {key} = {v!r}; expected a list of folder names"
+            )
+    for key in ("name", "out"):
+        if key in st and not isinstance(st[key], str):
+            raise ConfigError(f"study file {path}: [study] {key} = {st[key]!r}; expected text")
     base = path.resolve().parent
     out = st.get("out")
     return Study(

@@ -904,8 +904,7 @@ _SCENE_FILE_XFAIL = {"binary.toml", "fold_path.npz"}  # UnicodeDecodeError escap
 _PARAM_XFAIL: set[str] = set()
 _PARAM_VALUE_XFAIL: set[str] = set()
 _DOF_XFAIL: set[str] = set()
-# a TypeError/UnicodeDecodeError escapes from load_study
-_STUDY_XFAIL = {"paths_number", "study_number", "grid_number", "points_number", "binary"}
+_STUDY_XFAIL: set[str] = set()
 
 
 def _pattern_needle(name: str) -> str:
