@@ -601,16 +601,18 @@ def check_output_folder(out: str | Path, *, overwrite: bool = False) -> Path:
     for parent in out.absolute().parents:
         if parent.exists() and not parent.is_dir():
             raise ConfigError(f"--out {out}: {parent} is a file, not a folder")
-    if not out.is_dir() or not any(out.iterdir()):
+    if not out.is_dir():
         return out
     real = out.resolve()
     if real == Path.cwd().resolve() or real in Path.cwd().resolve().parents:
         raise ConfigError(f"--out {out} is the working folder or one of its parents; choose "
                           "a folder for the results")  # fmt: skip
-    if real == Path.home().resolve() or real == Path(real.anchor):
-        raise ConfigError(f"--out {out} is the home or root folder; choose a folder for the "
-                          "results")  # fmt: skip
-    if overwrite:
+    with contextlib.suppress(RuntimeError, KeyError):  # no home folder known
+        if real == Path.home().resolve():
+            raise ConfigError(f"--out {out} is the home folder; choose a folder for the results")
+    if real == Path(real.anchor):
+        raise ConfigError(f"--out {out} is the root folder; choose a folder for the results")
+    if overwrite or not any(out.iterdir()):
         return out
     if not (out / MANIFEST).is_file():
         raise ConfigError(
@@ -625,7 +627,7 @@ def check_output_folder(out: str | Path, *, overwrite: bool = False) -> Path:
     if extra:
         raise ConfigError(
             f"--out {out} holds {len(extra)} file(s) that are not part of its barhinge run "
-            f"({extra[0]}); pass --overwrite to replace the folder with them"
+            f"({extra[0]}); pass --overwrite to replace the folder, those files included"
         )
     return out
 
@@ -724,7 +726,6 @@ def result_folder(
         man = {**run.manifest, "files": _listed_files(tmp)}
         (tmp / MANIFEST).write_text(json.dumps(_clean(man), indent=2) + "\n")
         _fsync_tree(tmp)
-        check_output_folder(out, overwrite=overwrite)  # unchanged while we were solving?
         if not out.exists():
             os.rename(tmp, out)
         elif _exchange(tmp, out):

@@ -106,9 +106,10 @@ def test_output_folder_checks(tmp_path, monkeypatch):
         check_output_folder(tmp_path / "run")
     with pytest.raises(ConfigError, match="not of the run: notes.txt"):
         read_manifest(tmp_path / "run")
-    monkeypatch.chdir(tmp_path)
-    with pytest.raises(ConfigError, match="working folder"):
-        check_output_folder(Path("."), overwrite=True)
+    monkeypatch.chdir(tmp_path / "empty")
+    for where in (".", ".."):  # never renamed away from under the process, even if empty
+        with pytest.raises(ConfigError, match="working folder"):
+            check_output_folder(Path(where), overwrite=True)
 
 
 def test_a_killed_runs_leftover_is_removed_by_the_next_run(tmp_path):
@@ -234,3 +235,15 @@ def test_fold_not_converged_is_marked_in_the_manifest(tmp_path):
     assert isinstance(res.exception, bh.ConvergenceError)
     man = read_manifest(out)
     assert man["converged"] is False and man["reason"] == "not converged"
+
+
+@pytest.mark.slow
+def test_render_into_a_result_folder_keeps_it_one_run(tmp_path, monkeypatch):
+    monkeypatch.setenv("BARHINGE_OFFSCREEN", "0")  # matplotlib pictures: fast and GL-free
+    out = tmp_path / "out"
+    assert _fold([str(miura_scene(tmp_path, steps=2)), "--out", str(out)]).exit_code == 0
+    res = CliRunner().invoke(app, ["render", str(out / "fold_path.npz"), "--no-gif", "--json"])
+    assert res.exit_code == 0, res.output
+    files = read_manifest(out)["files"]  # the pictures are listed; nothing half written
+    assert "fold_path_charts.png" in files and "fold_path_fold_angle_deg_0002.png" in files
+    assert not [p for p in out.iterdir() if p.name.startswith(".")]
