@@ -400,7 +400,7 @@ def form_only_model(scene) -> tuple[str, str]:
     return "rigid", "actuators only"
 
 
-def _fold_form_rigid(scene, out: Path) -> tuple[object, dict] | None:
+def _fold_form_rigid(scene, out: Path, overwrite: bool = False) -> tuple[object, dict] | None:
     """Fold ``scene`` by rigid kinematics and write fold_path.npz, fold_path.fold and
     summary.json into ``out``; None (with the reason on stderr) when rigid kinematics cannot
     follow the actuators, so the caller falls back to the bar-and-hinge solver."""
@@ -426,8 +426,6 @@ def _fold_form_rigid(scene, out: Path) -> tuple[object, dict] | None:
         err_console.print(f"rigid kinematics cannot fold it ({exc}); using the bar-and-hinge model",
                           highlight=False, markup=False, soft_wrap=True)  # fmt: skip
         return None
-    out.mkdir(parents=True, exist_ok=True)
-    files = [path.save(out / "fold_path.npz"), write_fold_path(cp, path, out / "fold_path.fold")]
     rho = path.fold_angles_deg[-1]
     info = {
         "scene": scene.name,
@@ -441,9 +439,16 @@ def _fold_form_rigid(scene, out: Path) -> tuple[object, dict] | None:
         },
         "closure_residual": path.meta.get("max_residual"),
     }
-    js = out / "summary.json"
-    js.write_text(json.dumps(info, indent=2, default=_json_default) + "\n")
-    files.append(js)
+    from barhinge.io import MANIFEST, result_folder
+
+    with result_folder(out, overwrite=overwrite, command="fold --form-only") as run:
+        path.save(run.path / "fold_path.npz")
+        write_fold_path(cp, path, run.path / "fold_path.fold")
+        js = json.dumps(info, indent=2, default=_json_default) + "\n"
+        (run.path / "summary.json").write_text(js)
+        run.manifest.update(scene=scene.name, kind="rigid", converged=True, reason=None,
+                            message="", n_states=int(path.n_states))  # fmt: skip
+    files = [out / n for n in ("fold_path.npz", "fold_path.fold", "summary.json", MANIFEST)]
     return path, {**info, "files": [str(f) for f in files]}
 
 
@@ -465,18 +470,33 @@ def fold_cmd(
             "actuators only (exact, fastest), else the bar-and-hinge solver.",
         ),
     ] = False,
+    overwrite: Annotated[
+        bool,
+        typer.Option(
+            "--overwrite",
+            help="Replace --out even when it is a non-empty folder that is not a barhinge "
+            "result folder (a previous result folder is always replaced whole).",
+        ),
+    ] = False,
 ) -> None:
-    """Fold a scene: solve it step by step, write the fold path and a summary."""
+    """Fold a scene: solve it step by step, write the fold path and a summary.
+
+    The output folder is replaced atomically at the end (docs/results.md); Ctrl-C writes
+    the converged steps and exits with code 130.
+    """
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
 
+    from barhinge.io import check_output_folder
+    from barhinge.results import Interrupted
     from barhinge.scene import default_scene, load_scene
     from barhinge.solve.newton import solve
     from barhinge.solve.outputs import summary, write_outputs
 
     scene = default_scene() if scene_file is None else load_scene(scene_file)
+    check_output_folder(out, overwrite=overwrite)  # before the solve, not after
     if form_only and form_only_model(scene)[0] == "rigid":
-        done = _fold_form_rigid(scene, out)
+        done = _fold_form_rigid(scene, out, overwrite)
         if done is not None:
             if as_json:
                 print_json(done[1])
@@ -493,17 +513,28 @@ def fold_cmd(
         console=err_console,
         disable=as_json,
     )
-    with bar:
-        task = bar.add_task("fold", total=scene.steps)
-        try:
-            path = solve(scene, progress=lambda done, total, v: bar.update(task, completed=done))
-        except ConvergenceError as exc:
-            if exc.last_state is not None:
-                write_outputs(exc.last_state, scene, out)
-                _print_events(exc.last_state, err_console)
-                err_console.print(f"partial results ({exc.last_state.n_states} states) in {out}")
-            raise
-    files = write_outputs(path, scene, out)
+    try:
+        with bar:
+            task = bar.add_task("fold", total=scene.steps)
+            try:
+                path = solve(scene, progress=lambda d, total, v: bar.update(task, completed=d))
+            except (ConvergenceError, Interrupted) as exc:
+                part = exc.last_state
+                if part is not None:
+                    write_outputs(part, scene, out, overwrite=overwrite)
+                    _print_events(part, err_console)
+                    err_console.print(f"partial results ({part.n_states} states) in {out}",
+                                      highlight=False, markup=False)  # fmt: skip
+                raise
+        files = write_outputs(path, scene, out, overwrite=overwrite)
+    except Interrupted as exc:
+        part = exc.last_state
+        msg = part.message if part is not None else "interrupted (Ctrl-C) before state 0"
+        err_console.print(msg, highlight=False, markup=False)
+        sys.exit(130)
+    except KeyboardInterrupt:
+        err_console.print(f"interrupted; {out} unchanged", highlight=False, markup=False)
+        sys.exit(130)
     info = summary(path, scene)
     from barhinge.plot import results_rows, results_summary
 
@@ -643,6 +674,7 @@ def render(
 ) -> None:
     """Re-render the pictures of a saved fold path (PNG of one state, charts, GIF)."""
     from barhinge.errors import ConfigError
+    from barhinge.io import add_to_manifest, atomic_file
     from barhinge.plot import charts
     from barhinge.plot import render as rnd
     from barhinge.results import FoldPath
@@ -665,28 +697,29 @@ def render(
     if not -n <= step < n:
         raise ConfigError(f"--step {step} is outside the path's {n} states")
     folder = out if out is not None else result.parent
+    if folder.exists() and not folder.is_dir():
+        raise ConfigError(f"--out {folder} is a file, not a folder")
     folder.mkdir(parents=True, exist_ok=True)
     stem = result.name.removesuffix(".npz")
     s = step % n
     X = fp.X[:, : cp.n_vertices]
     written = {
-        "png": rnd.render_state(
-            X[s],
-            folder / f"{stem}_{scalars}_{s:04d}.png",
-            pattern=cp,
-            scalars=scalars,
-            fold_angles_deg=fp.fold_angles_deg[s],
-            title=f"state {s} of {n - 1}",
-            backend=backend,
-        )
+        "png": folder / f"{stem}_{scalars}_{s:04d}.png",
+        "charts": folder / f"{stem}_charts.png",
     }
-    written["charts"] = folder / f"{stem}_charts.png"
-    charts.summary_figure(fp, written["charts"])
+    # each picture is written beside its name and renamed into place (never half a file)
+    with atomic_file(written["png"]) as tmp:
+        rnd.render_state(X[s], tmp, pattern=cp, scalars=scalars,
+                         fold_angles_deg=fp.fold_angles_deg[s], title=f"state {s} of {n - 1}",
+                         backend=backend)  # fmt: skip
+    with atomic_file(written["charts"]) as tmp:
+        charts.summary_figure(fp, tmp)
     if gif and n > 1:
         fp_v = FoldPath(X=X, fold_angles_deg=fp.fold_angles_deg, kind=fp.kind)
-        written["gif"] = rnd.animate(
-            fp_v, folder / f"{stem}.gif", pattern=cp, scalars=scalars, backend=backend
-        )
+        written["gif"] = folder / f"{stem}.gif"
+        with atomic_file(written["gif"]) as tmp:
+            rnd.animate(fp_v, tmp, pattern=cp, scalars=scalars, backend=backend)
+    add_to_manifest(folder, list(written.values()))  # a result folder lists them as its own
     if as_json:
         print_json({k: str(v) for k, v in written.items()})
     else:

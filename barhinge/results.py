@@ -6,14 +6,35 @@ requested steps. Angles are stored in degrees (FOLD convention, valley > 0).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
+import os
+import secrets
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-__all__ = ["FoldPath"]
+__all__ = ["FoldPath", "Interrupted"]
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C (KeyboardInterrupt) during a solve, carrying the converged part of the path.
+
+    A subclass of KeyboardInterrupt, not of ``BarhingeError``: code that catches
+    ``Exception`` or the package's errors still lets an interrupt through.
+
+    Attributes
+    ----------
+    last_state : FoldPath or None
+        The states converged before the interrupt (``converged=False``,
+        ``meta["stopped"] = "interrupted"``); None when not even state 0 was reached.
+    """
+
+    def __init__(self, message: str = "interrupted", *, last_state: Any = None) -> None:
+        super().__init__(message)
+        self.last_state = last_state
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -134,8 +155,14 @@ class FoldPath:
 
     # ------------------------------------------------------------------- files
     def save(self, path: str | Path) -> Path:
-        """Write the path to an ``.npz`` file (lossless)."""
+        """Write the path to an ``.npz`` file (lossless; ``.npz`` is appended if missing).
+
+        Atomic: the data go to a temporary file in the same folder, which then replaces
+        ``path`` (``os.replace``), so a reader sees the old file or the new one, never a
+        truncated one.
+        """
         path = Path(path)
+        final = path if path.suffix == ".npz" else path.with_suffix(path.suffix + ".npz")
         arrays: dict[str, Any] = {}
         scalars: dict[str, Any] = {}
         for f in dataclasses.fields(self):
@@ -147,8 +174,20 @@ class FoldPath:
             else:
                 scalars[f.name] = v
         arrays["__json__"] = np.array(json.dumps(scalars))
-        np.savez_compressed(path, **arrays)
-        return path if path.suffix == ".npz" else path.with_suffix(path.suffix + ".npz")
+        # a unique sibling, created with the umask's permissions (mkstemp would give 0600)
+        tmp = final.with_name(f".{final.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                np.savez_compressed(fh, **arrays)
+                fh.flush()
+                os.fsync(fh.fileno())
+            os.replace(tmp, final)
+        except BaseException:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+            raise
+        return final
 
     @classmethod
     def load(cls, path: str | Path) -> FoldPath:

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from barhinge.errors import ConfigError, ConvergenceError
-from barhinge.results import FoldPath
+from barhinge.results import FoldPath, Interrupted
 from barhinge.solve.branch import RigidGuide, creases_against_assignment, is_flat, rigid_guide
 from barhinge.solve.controls import (
     BorderedSystem,
@@ -603,6 +603,18 @@ class _Driver:
             meta=meta,
         )
 
+    def interrupted_path(self) -> FoldPath | None:
+        """The converged part after a Ctrl-C (``meta["stopped"] = "interrupted"``); None
+        before state 0."""
+        if not self.records:
+            return None
+        n = len(self.records) - 1
+        lam = float(self.records[-1]["lam"])
+        msg = f"interrupted (Ctrl-C) after {n} converged steps, at load factor {lam:.6g}"
+        path = self.path(converged=False, message=msg)
+        path.meta["stopped"] = "interrupted"
+        return path
+
     def fail(self, step: int, lam: float, why: str, res: list[float]) -> ConvergenceError:
         msg = (
             f"step {step} of {self.scene.steps} did not converge at load factor {lam:.6g} "
@@ -906,8 +918,13 @@ def solve(scene: Scene, progress: Progress | None = None) -> FoldPath:
     ConvergenceError
         When a step does not converge after ``options.max_cutbacks`` halvings; its
         ``last_state`` is the partial FoldPath of the converged steps.
+    Interrupted
+        On Ctrl-C (a KeyboardInterrupt); its ``last_state`` is the converged part.
     """
     d = _Driver(scene)
-    if scene.control == "arc_length":
-        return d.run_arc_length(progress)
-    return d.run_parameter(progress)
+    try:
+        if scene.control == "arc_length":
+            return d.run_arc_length(progress)
+        return d.run_parameter(progress)
+    except KeyboardInterrupt:
+        raise Interrupted(last_state=d.interrupted_path()) from None

@@ -1,4 +1,5 @@
-"""Writing a solved fold path to a folder: the FoldPath (npz), a summary (JSON and CSV).
+"""Writing a solved fold path to a result folder, atomically: the FoldPath (npz), a summary
+(JSON and CSV), the hooks' files and the manifest (:func:`barhinge.io.result_folder`).
 
 Other modules add files (pictures, VTU series) by appending a function to
 :data:`OUTPUT_HOOKS`; :func:`write_outputs` calls each hook after its own files.
@@ -17,7 +18,7 @@ import numpy as np
 
 from barhinge.results import FoldPath
 
-__all__ = ["OUTPUT_HOOKS", "summary", "write_outputs"]
+__all__ = ["OUTPUT_HOOKS", "stop_reason", "summary", "write_outputs"]
 
 log = logging.getLogger(__name__)
 
@@ -42,6 +43,7 @@ def summary(path: FoldPath, scene: Any = None) -> dict[str, Any]:
         "scene": path.meta.get("scene", getattr(scene, "name", "")),
         "control": path.meta.get("control"),
         "converged": bool(path.converged),
+        "reason": stop_reason(path),
         "message": path.message,
         "n_states": int(path.n_states),
         "n_nodes": int(path.X.shape[1]),
@@ -77,11 +79,52 @@ def summary(path: FoldPath, scene: Any = None) -> dict[str, Any]:
     return out
 
 
-def write_outputs(path: FoldPath, scene: Any, out_dir: str | Path) -> list[Path]:
-    """Write ``fold_path.npz``, ``summary.json`` and ``states.csv`` into ``out_dir`` (created),
-    then every :data:`OUTPUT_HOOKS` writer. Returns the written files."""
+def stop_reason(path: FoldPath) -> str | None:
+    """Why a path stopped early: None (it converged), ``"interrupted"`` (Ctrl-C) or
+    ``"not converged"``."""
+    if path.converged:
+        return None
+    return str(path.meta.get("stopped") or "not converged")
+
+
+def write_outputs(
+    path: FoldPath, scene: Any, out_dir: str | Path, *, overwrite: bool = False
+) -> list[Path]:
+    """Write a run into ``out_dir`` atomically and return its files (in ``out_dir``).
+
+    ``fold_path.npz``, ``summary.json``, ``states.csv``, every :data:`OUTPUT_HOOKS` writer's
+    files and the manifest ``barhinge-run.json`` (files, scene, version, ``converged`` and
+    ``reason``: None, ``"not converged"`` or ``"interrupted"``) go to a temporary sibling
+    folder that then replaces ``out_dir`` whole (:func:`barhinge.io.result_folder`): no
+    stale files of an earlier run remain, and a kill leaves the previous run untouched.
+
+    Raises
+    ------
+    ConfigError
+        ``out_dir`` is a file, or a non-empty folder that is not a barhinge result folder
+        (without ``overwrite``).
+    """
+    from barhinge.io import MANIFEST, result_folder
+
+    with result_folder(out_dir, overwrite=overwrite, command="fold") as run:
+        tmp_files = _write_run(path, scene, run.path)
+        run.manifest.update(
+            scene=path.meta.get("scene", getattr(scene, "name", "")),
+            kind=path.kind,
+            converged=bool(path.converged),
+            reason=stop_reason(path),
+            message=path.message,
+            n_states=int(path.n_states),
+            n_nodes=int(path.X.shape[1]),
+        )
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    moved = [out / (f.relative_to(run.path) if f.is_relative_to(run.path) else f.name)
+             for f in map(Path, tmp_files)]  # fmt: skip
+    return [*moved, out / MANIFEST]
+
+
+def _write_run(path: FoldPath, scene: Any, out: Path) -> list[Path]:
+    """The files of :func:`write_outputs`, written straight into ``out``."""
     files = [path.save(out / "fold_path.npz")]
     js = out / "summary.json"
     js.write_text(json.dumps(summary(path, scene), indent=2) + "\n")
