@@ -20,6 +20,7 @@ import datetime
 import errno
 import glob
 import json
+import tempfile
 import logging
 import os
 import secrets
@@ -583,6 +584,20 @@ def read_manifest(folder: str | Path, *, check: bool = True) -> dict[str, Any]:
     return man
 
 
+def _probe_writable(out: Path) -> None:
+    """ConfigError unless a folder can be made beside ``out`` (where the run is written
+    before it is swapped in): its parent is created if needed and probed with a real
+    folder, since permission bits do not tell (root, read-only or virtual file systems)."""
+    parent = out.absolute().parent
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        probe = tempfile.mkdtemp(prefix=".barhinge-probe-", dir=parent)
+        os.rmdir(probe)
+    except OSError as exc:
+        why = exc.strerror or type(exc).__name__
+        raise ConfigError(f"--out {out}: cannot write in {parent} ({why})") from None
+
+
 def check_output_folder(out: str | Path, *, overwrite: bool = False) -> Path:
     """Check, before any work, that ``out`` may receive a run; returns it.
 
@@ -601,6 +616,7 @@ def check_output_folder(out: str | Path, *, overwrite: bool = False) -> Path:
     for parent in out.absolute().parents:
         if parent.exists() and not parent.is_dir():
             raise ConfigError(f"--out {out}: {parent} is a file, not a folder")
+    _probe_writable(out)
     if not out.is_dir():
         return out
     real = out.resolve()

@@ -22,6 +22,7 @@
 from __future__ import annotations
 
 import logging
+import re
 from pathlib import Path
 
 import numpy as np
@@ -82,6 +83,20 @@ def _float(v, what: str, where: str) -> float:
     return min(max(x, 0.0), 1.0)
 
 
+#: geometry attributes of the basic shapes, checked for a finite length before use
+_LENGTH_ATTRS = ("x1", "y1", "x2", "y2", "x", "y", "width", "height", "cx", "cy", "r", "rx", "ry")
+_LENGTH_RE = re.compile(r"^\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?\s*(px|pt|mm|cm|in|pc|%)?\s*$")
+
+
+def _check_lengths(values: dict, where: str) -> None:
+    """PatternError naming the first geometry attribute that is not a finite length (a
+    malformed value would otherwise make svgelements drop the shape without a word)."""
+    for key in _LENGTH_ATTRS:
+        v = values.get(key)
+        if isinstance(v, str) and not _LENGTH_RE.match(v):
+            raise PatternError(f"{where}: attribute {key}={v!r} is not a finite length")
+
+
 def _segments(path: Path) -> tuple[np.ndarray, list[str], list[float], dict]:
     """Straight segments (k, 4) [x0, y0, x1, y1] in SVG coordinates, their assignments and
     fold angles (degrees)."""
@@ -117,6 +132,7 @@ def _segments(path: Path) -> tuple[np.ndarray, list[str], list[float], dict]:
         if a is None:
             stats["skipped_colours"] += 1
             continue
+        _check_lengths(values, where)
         op = _float(values.get("opacity"), "opacity", where)
         if values.get("stroke-opacity") is not None:  # exact value, not the 8-bit alpha
             sop = _float(values.get("stroke-opacity"), "stroke-opacity", where)
