@@ -85,11 +85,16 @@ class Material:
             self, "nu", _check.number(self.nu, "material.nu", 0.0, 0.5, hi_open=True)
         )
         object.__setattr__(self, "t", _check.number(self.t, "material.t", 0.0, lo_open=True))
+        if not np.isfinite(self.bending_rigidity) or self.bending_rigidity == 0.0:
+            raise ConfigError(
+                f"material.t = {self.t!r} with material.E = {self.E!r}: the bending rigidity "
+                "E t^3 / (12 (1 - nu^2)) is not a positive finite number"
+            )
 
     @property
     def bending_rigidity(self) -> float:
         """Plate bending rigidity ``D = E t^3 / (12 (1 - nu^2))`` (force x length)."""
-        return self.E * self.t**3 / (12.0 * (1.0 - self.nu**2))
+        return self.E * self.t * self.t * self.t / (12.0 * (1.0 - self.nu * self.nu))
 
     def membrane_mandel(self) -> np.ndarray:
         """(3, 3) plane-stress stiffness in Mandel notation (shear entry ``E/(1+nu)``)."""
