@@ -111,7 +111,7 @@ class Scene:
                     f"actuators.table_deg has {len(acts.table_deg)} rows, but steps = "
                     f"{self.steps}; give one row per step"
                 )
-        control = self.control
+        control = _check.choice(self.control, "control", CONTROLS)
         if control == "auto":
             if acts is not None and acts.n:
                 control = "fold_angle"
@@ -119,7 +119,6 @@ class Scene:
                 control = "displacement"
             else:
                 control = "load"
-        _check.choice(control, "control", CONTROLS)
         if control == "fold_angle" and (acts is None or not acts.n):
             raise ConfigError("control 'fold_angle' needs actuators")
         if control == "displacement" and not np.isfinite(P).any():
