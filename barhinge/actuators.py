@@ -11,6 +11,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from barhinge import _check
 from barhinge.errors import ConfigError
 
 __all__ = ["Actuators"]
@@ -37,31 +38,41 @@ class Actuators:
     table_deg: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        e = np.asarray(self.edges, dtype=np.int64).ravel()
+        e = _check.int_array(self.edges, "actuators.edges", lo=0)
         if len(np.unique(e)) != len(e):
-            raise ConfigError(f"actuator edges repeat: {e.tolist()}")
+            raise ConfigError(f"actuators.edges repeat: {e.tolist()}")
         object.__setattr__(self, "edges", e)
         if (self.targets_deg is None) == (self.table_deg is None):
-            raise ConfigError("give exactly one of targets_deg (final angles) or table_deg")
+            raise ConfigError(
+                "actuators: give exactly one of targets_deg (final angles) or table_deg"
+            )
         if self.targets_deg is not None:
-            t = np.asarray(self.targets_deg, dtype=float).ravel()
+            t = _check.float_array(self.targets_deg, "actuators.targets_deg").ravel()
             if t.size == 1 and len(e) > 1:
                 t = np.full(len(e), float(t[0]))
             if len(t) != len(e):
-                raise ConfigError(f"len(edges) = {len(e)}, but len(targets_deg) = {len(t)}")
+                raise ConfigError(
+                    f"actuators.targets_deg has {len(t)} entries, but actuators.edges has {len(e)}"
+                )
             if np.any(np.abs(t) >= 180.0):
                 bad = int(np.flatnonzero(np.abs(t) >= 180.0)[0])
                 raise ConfigError(
-                    f"actuator {bad} (edge {e[bad]}) has target {t[bad]} deg; |target| < 180"
+                    f"actuators.targets_deg = {t[bad]} for edge {e[bad]}; expected |angle| < 180"
                 )
             object.__setattr__(self, "targets_deg", t)
         else:
-            T = np.asarray(self.table_deg, dtype=float)
-            if T.ndim == 1:
+            T = _check.float_array(self.table_deg, "actuators.table_deg")
+            if T.ndim == 1 and len(e) == 1:
                 T = T[:, None]
-            if T.ndim != 2 or T.shape[1] != len(e):
+            if T.ndim != 2 or T.shape[1] != len(e) or len(T) < 1:
                 raise ConfigError(
-                    f"table_deg must have shape (n_steps, {len(e)}), got {np.shape(self.table_deg)}"
+                    f"actuators.table_deg must have shape (n_steps, {len(e)}), got {T.shape}"
+                )
+            if np.any(np.abs(T) >= 180.0):
+                i, j = np.argwhere(np.abs(T) >= 180.0)[0]
+                raise ConfigError(
+                    f"actuators.table_deg = {T[i, j]} at step {i + 1}, edge {e[j]}; "
+                    "expected |angle| < 180"
                 )
             object.__setattr__(self, "table_deg", T)
 
@@ -76,7 +87,12 @@ class Actuators:
         from the start to the targets; with ``table_deg`` its rows are used (its length must
         equal ``steps``).
         """
-        start = np.zeros(self.n) if start_deg is None else np.asarray(start_deg, float).ravel()
+        steps = _check.integer(steps, "steps", 1)
+        start = (
+            np.zeros(self.n)
+            if start_deg is None
+            else _check.float_array(start_deg, "start_deg").ravel()
+        )
         if len(start) != self.n:
             raise ConfigError(f"len(start_deg) = {len(start)}, but there are {self.n} actuators")
         if self.table_deg is not None:
@@ -85,8 +101,6 @@ class Actuators:
                     f"table_deg has {len(self.table_deg)} rows, but {steps} steps were asked"
                 )
             return np.vstack([start, self.table_deg])
-        if steps < 1:
-            raise ConfigError(f"steps must be >= 1, got {steps}")
         s = np.linspace(0.0, 1.0, steps + 1)[:, None]
         return start[None, :] + s * (self.targets_deg - start)[None, :]
 

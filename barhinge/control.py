@@ -42,6 +42,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 from scipy.optimize import brentq
 
+from barhinge import _check
 from barhinge.actuators import Actuators
 from barhinge.errors import ConfigError, PatternError
 from barhinge.pattern.crease import CreasePattern
@@ -96,6 +97,9 @@ class CircularArc(ControlCurve):
 
     kappa: float
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "kappa", _check.number(self.kappa, "kappa"))
+
     def point(self, u: np.ndarray | float) -> np.ndarray:
         u = np.asarray(u, dtype=float)
         k = float(self.kappa)
@@ -113,6 +117,9 @@ class Parabola(ControlCurve):
     """Parabola ``z = c x^2 / 2`` (curvature ``c`` at the apex, the origin); ``u = x``."""
 
     c: float
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "c", _check.number(self.c, "c"))
 
     def point(self, u: np.ndarray | float) -> np.ndarray:
         x = np.asarray(u, dtype=float)
@@ -137,8 +144,8 @@ class SplineCurve(ControlCurve):
     z: Sequence[float] | np.ndarray
 
     def __post_init__(self) -> None:
-        x = np.asarray(self.x, dtype=float).ravel()
-        z = np.asarray(self.z, dtype=float).ravel()
+        x = _check.float_array(self.x, "spline x").ravel()
+        z = _check.float_array(self.z, "spline z").ravel()
         if len(x) != len(z) or len(x) < 2:
             raise ConfigError(
                 f"spline needs >= 2 points and len(x) == len(z), got {len(x)}, {len(z)}"
@@ -249,7 +256,7 @@ def chain_on_curve(
         Points on the curve with ``|P_{i+1} - P_i| = x_{i+1} - x_i`` (to round-off) and the
         turning angles at the ``m - 2`` interior points.
     """
-    x = np.asarray(x, dtype=float).ravel()
+    x = _check.float_array(x, "section coordinates").ravel()
     if len(x) < 3:
         raise ConfigError(f"a chain needs >= 3 points (two ends and an actuator), got {len(x)}")
     gaps = np.diff(x)
@@ -314,7 +321,10 @@ def curve_angles_deg(
     -------
     (n,) float
     """
-    x = np.asarray(x, dtype=float).ravel()
+    x = _check.float_array(x, "section coordinates").ravel()
+    amplitude_deg = _check.number(
+        amplitude_deg, "amplitude_deg", -180.0, 180.0, lo_open=True, hi_open=True
+    )
     if mapping == "turning":
         chain = chain_on_curve(
             curve, np.concatenate([[float(ends[0])], x, [float(ends[1])]]), anchor=anchor
@@ -414,8 +424,8 @@ def spaced_lines(
     (k,) int
         Edge ids of the chosen lines (all edges of each line).
     """
-    if not spacing > 0:
-        raise ConfigError(f"actuator spacing must be > 0, got {spacing}")
+    spacing = _check.number(spacing, "spacing", 0.0, lo_open=True)
+    offset = _check.number(offset, "offset")
     x, groups, _ = section_lines(cp, candidates, direction)
     targets = np.arange(x[0] + offset, x[-1] + 0.5 * spacing, spacing)
     chosen = sorted({int(np.argmin(np.abs(x - t))) for t in targets})
@@ -545,8 +555,7 @@ def curve_schedule(
     Actuators
         With ``table_deg`` of shape (steps, n_edges); ``schedule(steps)`` starts flat.
     """
-    if steps < 1:
-        raise ConfigError(f"steps must be >= 1, got {steps}")
+    steps = _check.integer(steps, "steps", 1)
     rows = [
         curve_actuators(cp, edges, curve.scaled(k / steps), **kwargs) for k in range(1, steps + 1)
     ]
@@ -555,8 +564,9 @@ def curve_schedule(
 
 def synchronised(edges: Sequence[int] | np.ndarray, angle_deg: float) -> Actuators:
     """All actuators folded alike: ``targets_deg = angle_deg`` for every edge."""
-    E = np.asarray(edges, dtype=np.int64).ravel()
-    return Actuators(edges=E, targets_deg=np.full(len(E), float(angle_deg)))
+    E = _check.int_array(edges, "actuators.edges", lo=0)
+    angle = _check.number(angle_deg, "angle_deg", -180.0, 180.0, lo_open=True, hi_open=True)
+    return Actuators(edges=E, targets_deg=np.full(len(E), angle))
 
 
 def current_angles_deg(cp: CreasePattern, edges: Sequence[int] | np.ndarray) -> np.ndarray:

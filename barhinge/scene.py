@@ -18,9 +18,10 @@ from typing import Any
 
 import numpy as np
 
+from barhinge import _check
 from barhinge._typing import ControlKind
 from barhinge.actuators import Actuators
-from barhinge.errors import ConfigError, PatternError
+from barhinge.errors import BarhingeError, ConfigError, PatternError
 from barhinge.solve.options import SolverOptions
 
 __all__ = [
@@ -72,6 +73,8 @@ class Scene:
     name: str = "scene"
 
     def __post_init__(self) -> None:
+        if not hasattr(self.model, "n_nodes") or not hasattr(self.model, "X0"):
+            raise ConfigError(f"model must be a BarHingeModel, got {type(self.model).__name__}")
         n = int(self.model.n_nodes)
         auto = False
         if self.prescribed is not None:
@@ -90,8 +93,8 @@ class Scene:
             i, c = np.argwhere(both)[0]
             raise ConfigError(f"node {i} component {'xyz'[c]} is both supported and prescribed")
         L = np.zeros((n, 3)) if self.loads is None else _node_array(self.loads, n, "loads", float)
-        if not isinstance(self.steps, int | np.integer) or self.steps < 1:
-            raise ConfigError(f"steps = {self.steps!r}; expected an integer >= 1")
+        _check.integer(self.steps, "steps", 1, MAX_STEPS)
+        _check.text(self.name, "name")
         acts = self.actuators
         if acts is not None and not isinstance(acts, Actuators):
             raise ConfigError(f"actuators must be an Actuators object, got {type(acts).__name__}")
@@ -103,7 +106,12 @@ class Scene:
             no_hinge = [int(e) for e in acts.edges if self.model.fold_hinge_of_edge[e] < 0]
             if no_hinge:
                 raise ConfigError(f"actuator edge {no_hinge[0]} has no fold hinge (not a crease)")
-        control = self.control
+            if acts.table_deg is not None and len(acts.table_deg) != self.steps:
+                raise ConfigError(
+                    f"actuators.table_deg has {len(acts.table_deg)} rows, but steps = "
+                    f"{self.steps}; give one row per step"
+                )
+        control = _check.choice(self.control, "control", CONTROLS)
         if control == "auto":
             if acts is not None and acts.n:
                 control = "fold_angle"
@@ -111,8 +119,6 @@ class Scene:
                 control = "displacement"
             else:
                 control = "load"
-        if control not in CONTROLS:
-            raise ConfigError(f"control = {control!r}; expected one of {', '.join(CONTROLS)}")
         if control == "fold_angle" and (acts is None or not acts.n):
             raise ConfigError("control 'fold_angle' needs actuators")
         if control == "displacement" and not np.isfinite(P).any():
@@ -165,11 +171,15 @@ class Scene:
 
 
 def _node_array(a: Any, n: int, what: str, dtype: type) -> np.ndarray:
-    arr = np.asarray(a, dtype=dtype)
+    if dtype is bool:
+        arr = np.asarray(a)
+        if arr.dtype != bool:
+            raise ConfigError(f"{what} must be a boolean array, got dtype {arr.dtype}")
+    else:
+        # prescribed: NaN = free; loads: finite
+        arr = _check.float_array(a, what, allow_nan=what == "prescribed")
     if arr.shape != (n, 3):
         raise ConfigError(f"{what} must have shape (n_nodes, 3) = ({n}, 3), got {arr.shape}")
-    if dtype is float and what != "prescribed" and not np.all(np.isfinite(arr)):
-        raise ConfigError(f"{what} has non-finite entries")
     return arr.copy()
 
 
@@ -194,13 +204,18 @@ def restraint_321(model: Any) -> np.ndarray:
     S[a] = True
     S[b, np.argsort(np.abs(ab))[:2]] = True
     S[c, int(np.argmax(np.abs(cross[c])))] = True
-    # check: the six rigid-body velocities restricted to the fixed DOFs have rank 6
+    # check: the six rigid-body velocities restricted to the fixed DOFs have rank 6; the
+    # rotations act on coordinates relative to the centroid over the pattern's size, so the
+    # test is scale-free (a = b = 1e12 and a = b = 1e-12 sheets alike)
+    size = float(np.linalg.norm(np.ptp(V, axis=0)))
+    if not size > 0 or not np.isfinite(size):
+        raise PatternError("cannot restrain the pattern automatically (it has no extent)")
     rows = []
     for node in (a, b, c):
-        x = X[node]
+        x = (X[node] - V.mean(0)) / size
         modes = np.hstack([np.eye(3), -_skew(x)])  # v = t + w x r  -> [I, -[r]x] @ (t, w)
         rows.append(modes[S[node]])
-    if np.linalg.matrix_rank(np.vstack(rows), tol=1e-9 * max(1.0, float(np.ptp(V)))) < 6:
+    if np.linalg.matrix_rank(np.vstack(rows), tol=1e-9) < 6:
         raise PatternError("cannot restrain the pattern automatically (its vertices are collinear)")
     return S
 
@@ -266,66 +281,94 @@ def self_weight(model: Any, area_density: float, g: Any = (0.0, 0.0, -9.81)) -> 
 
 # ------------------------------------------------------------------------------ TOML
 _TOP_KEYS = {"name", "pattern", "model", "supports", "loads", "prescribed", "actuators", "solve"}
+#: upper bound of an integer parameter of a pattern family in a scene (cells, stories ...)
+MAX_PATTERN_COUNT = 10_000
 
 
 def load_scene(path: str | Path) -> Scene:
-    """Read a scene from a TOML file (see ``data/scenes/*.toml`` and docs/solver.md)."""
+    """Read a scene from a TOML file (see ``data/scenes/*.toml`` and docs/solver.md).
+
+    Every value is checked here for type, finiteness and range; a bad one raises
+    :class:`ConfigError` (or :class:`PatternError` for the pattern) with one line naming the
+    key as a dotted path (``model.material.E = inf; expected a finite number``).
+    """
     path = Path(path)
     try:
         with path.open("rb") as fh:
             data = tomllib.load(fh)
     except FileNotFoundError:
         raise ConfigError(f"scene file {str(path)!r} does not exist") from None
-    except tomllib.TOMLDecodeError as exc:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ConfigError(f"{path.name}: invalid TOML: {exc}") from None
+    except OSError as exc:
+        raise ConfigError(f"scene file {str(path)!r} cannot be read: {exc.strerror}") from None
     data.setdefault("name", path.stem)
     return scene_from_dict(data, base_dir=path.parent)
 
 
-def _check_keys(d: dict[str, Any], allowed: set[str], where: str) -> None:
+def _check_keys(d: Any, allowed: set[str], where: str) -> None:
     if not isinstance(d, dict):
-        raise ConfigError(f"[{where}] must be a table, got {type(d).__name__}")
+        raise ConfigError(f"{where} must be a table, got {type(d).__name__} {_check.show(d)}")
     for k in d:
         if k not in allowed:
             raise ConfigError(
-                f"unknown key {k!r} in [{where}]; expected one of {', '.join(sorted(allowed))}"
+                f"unknown key {k!r} in {where}; expected one of {', '.join(sorted(allowed))}"
             )
 
 
 def scene_from_dict(d: dict[str, Any], base_dir: str | Path = ".") -> Scene:
     """Build a :class:`Scene` from the TOML mapping (unknown keys raise ConfigError)."""
-    _check_keys(d, _TOP_KEYS, "scene")
-    cp = _pattern_from(d.get("pattern"), Path(base_dir))
+    _check_keys(d, _TOP_KEYS, "the scene")
+    # overflow (a pattern of size 1e300, a density of 1e308) is caught by the finiteness
+    # checks, which name the key; numpy's warnings would only repeat it
+    with np.errstate(over="ignore", invalid="ignore"):
+        return _scene_from_dict(d, Path(base_dir))
+
+
+def _scene_from_dict(d: dict[str, Any], base_dir: Path) -> Scene:
+    name = _check.text(d.get("name", "scene"), "name")
+    cp = _pattern_from(d.get("pattern"), base_dir)
     model = _model_from(cp, d.get("model", {}))
     n = model.n_nodes
     supports = None
     if "supports" in d:
         supports = np.zeros((n, 3), bool)
         for i, g in enumerate(_groups(d["supports"], "supports")):
-            _check_keys(g, _SELECT | {"dofs"}, f"supports.{i}")
-            supports[np.ix_(_nodes(model, g, f"supports.{i}"), _dofs(g))] = True
+            key = f"supports.{i}"
+            _check_keys(g, _SELECT | {"dofs"}, key)
+            supports[np.ix_(_nodes(model, g, key), _dofs(g, key))] = True
     loads = None
     if "loads" in d:
         loads = np.zeros((n, 3))
         for i, g in enumerate(_groups(d["loads"], "loads")):
-            _check_keys(g, _SELECT | {"force", "self_weight"}, f"loads.{i}")
+            key = f"loads.{i}"
+            _check_keys(g, _SELECT | {"force", "self_weight"}, key)
             if "self_weight" in g:
                 sw = g["self_weight"]
-                _check_keys(sw, {"area_density", "g"}, f"loads.{i}.self_weight")
+                _check_keys(sw, {"area_density", "g"}, f"{key}.self_weight")
                 if "area_density" not in sw:
-                    raise ConfigError(f"[loads.{i}.self_weight] needs area_density")
-                loads += self_weight(model, float(sw["area_density"]), sw.get("g", (0, 0, -9.81)))
+                    raise ConfigError(f"{key}.self_weight needs area_density")
+                rho = _check.number(sw["area_density"], f"{key}.self_weight.area_density", 0.0)
+                g3 = _vec3(sw.get("g", [0.0, 0.0, -9.81]), f"{key}.self_weight.g")
+                loads += self_weight(model, rho, g3)
             if "force" in g:
-                loads[_nodes(model, g, f"loads.{i}")] += _vec3(g["force"], f"loads.{i}.force")
+                loads[_nodes(model, g, key)] += _vec3(g["force"], f"{key}.force")
+            elif set(g) & _SELECT:
+                raise ConfigError(f"{key} selects nodes but gives no force = [fx, fy, fz]")
+            elif "self_weight" not in g:
+                raise ConfigError(f"{key} needs force = [fx, fy, fz] or self_weight")
+            if not np.isfinite(loads).all():
+                raise ConfigError(f"{key}: the loads overflow floating point")
     prescribed = None
     if "prescribed" in d:
         prescribed = np.full((n, 3), np.nan)
         for i, g in enumerate(_groups(d["prescribed"], "prescribed")):
-            _check_keys(g, _SELECT | {"displacement", "dofs"}, f"prescribed.{i}")
+            key = f"prescribed.{i}"
+            _check_keys(g, _SELECT | {"displacement", "dofs"}, key)
             if "displacement" not in g:
-                raise ConfigError(f"[prescribed.{i}] needs displacement = [ux, uy, uz]")
-            u = _vec3(g["displacement"], f"prescribed.{i}.displacement")
-            idx, comps = _nodes(model, g, f"prescribed.{i}"), _dofs(g)
+                raise ConfigError(f"{key} needs displacement = [ux, uy, uz]")
+            u = _vec3(g["displacement"], f"{key}.displacement")
+            idx, comps = _nodes(model, g, key), _dofs(g, key)
             prescribed[np.ix_(idx, comps)] = u[comps]
     actuators = None
     if "actuators" in d:
@@ -337,26 +380,32 @@ def scene_from_dict(d: dict[str, Any], base_dir: str | Path = ".") -> Scene:
                 raise ConfigError(f"actuators.edges = {edges!r}; expected a list or 'creases'")
             edges = cp.crease_edges
         if edges is None:
-            raise ConfigError("[actuators] needs edges")
+            raise ConfigError("actuators needs edges = [...] or edges = 'creases'")
         actuators = Actuators(
             edges=edges, targets_deg=a.get("targets_deg"), table_deg=a.get("table_deg")
         )
     solve = d.get("solve", {})
     _check_keys(solve, {"steps", "control", "options"}, "solve")
+    steps = _check.integer(solve.get("steps", 50), "solve.steps", 1, MAX_STEPS)
+    control = _check.choice(solve.get("control", "auto"), "solve.control", CONTROLS)
+    with _check.prefixed("solve.", {"options"}):
+        options = SolverOptions.from_dict(solve.get("options"))
     return Scene(
         model,
         supports=supports,
         loads=loads,
         prescribed=prescribed,
         actuators=actuators,
-        steps=int(solve.get("steps", 50)),
-        control=str(solve.get("control", "auto")),
-        options=SolverOptions.from_dict(solve.get("options")),
-        name=str(d.get("name", "scene")),
+        steps=steps,
+        control=control,
+        options=options,
+        name=name,
     )
 
 
 CONTROLS: tuple[str, ...] = (*typing.get_args(ControlKind), "auto")
+#: upper bound of ``steps`` (each step is a stored state)
+MAX_STEPS = 1_000_000
 _SELECT = {"vertices", "nodes", "edges", "where"}
 
 
@@ -365,7 +414,10 @@ def _groups(v: Any, where: str) -> list[dict[str, Any]]:
         return [v]
     if isinstance(v, list) and all(isinstance(g, dict) for g in v):
         return v
-    raise ConfigError(f"[{where}] must be a table or an array of tables ([[{where}]])")
+    raise ConfigError(
+        f"{where} must be a table or an array of tables (double brackets around {where}), "
+        f"got {_check.show(v)}"
+    )
 
 
 def _nodes(model: Any, g: dict[str, Any], where: str) -> np.ndarray:
@@ -373,91 +425,122 @@ def _nodes(model: Any, g: dict[str, Any], where: str) -> np.ndarray:
     n, cp = model.n_nodes, model.pattern
     ids: list[np.ndarray] = []
     if "vertices" in g:
-        v = np.asarray(g["vertices"], np.int64).ravel()
-        if v.size and (v.min() < 0 or v.max() >= cp.n_vertices):
-            raise ConfigError(f"[{where}] vertices must be in 0..{cp.n_vertices - 1}")
-        ids.append(v)
+        ids.append(_check.int_array(g["vertices"], f"{where}.vertices", 0, cp.n_vertices - 1))
     if "nodes" in g:
-        v = np.asarray(g["nodes"], np.int64).ravel()
-        if v.size and (v.min() < 0 or v.max() >= n):
-            raise ConfigError(f"[{where}] nodes must be in 0..{n - 1}")
-        ids.append(v)
+        ids.append(_check.int_array(g["nodes"], f"{where}.nodes", 0, n - 1))
     if "edges" in g:
-        e = np.asarray(g["edges"], np.int64).ravel()
-        if e.size and (e.min() < 0 or e.max() >= cp.n_edges):
-            raise ConfigError(f"[{where}] edges must be in 0..{cp.n_edges - 1}")
+        e = _check.int_array(g["edges"], f"{where}.edges", 0, cp.n_edges - 1)
         ids.append(np.asarray(cp.edges)[e].ravel())
     if "where" in g:
-        ids.append(select_vertices(model, g["where"]))
+        w = g["where"]
+        if not (isinstance(w, str) or (isinstance(w, list) and all(isinstance(x, str) for x in w))):
+            raise ConfigError(f"{where}.where = {_check.show(w)}; expected a name or a list")
+        with _check.prefixed(f"{where}.where: "):
+            ids.append(select_vertices(model, w))
     if not ids:
-        raise ConfigError(f"[{where}] selects nothing: give vertices, nodes, edges or where")
+        raise ConfigError(f"{where} selects nothing: give vertices, nodes, edges or where")
     out = np.unique(np.concatenate(ids))
     if out.size == 0:
-        raise ConfigError(f"[{where}] selects no node")
+        raise ConfigError(f"{where} selects no node")
     return out
 
 
-def _dofs(g: dict[str, Any]) -> list[int]:
-    s = str(g.get("dofs", "xyz")).lower()
-    if not s or any(c not in "xyz" for c in s):
-        raise ConfigError(f"dofs = {s!r}; expected letters from 'xyz'")
-    return sorted({"xyz".index(c) for c in s})
+def _dofs(g: dict[str, Any], where: str) -> list[int]:
+    s = g.get("dofs", "xyz")
+    if not isinstance(s, str) or not s or any(c not in "xyz" for c in s.lower()):
+        raise ConfigError(f"{where}.dofs = {_check.show(s)}; expected letters from 'xyz'")
+    return sorted({"xyz".index(c) for c in s.lower()})
 
 
 def _vec3(v: Any, where: str) -> np.ndarray:
-    a = np.asarray(v, float).ravel()
-    if a.shape != (3,):
-        raise ConfigError(f"{where} must have 3 components, got {len(a)}")
-    return a
+    return _check.float_array(v, where, (3,))
 
 
 def _pattern_from(p: Any, base: Path) -> Any:
     if p is None:
-        raise ConfigError("the scene needs a [pattern] table (family = ... or file = ...)")
+        raise ConfigError("the scene needs a pattern table (family = ... or file = ...)")
     _check_keys(p, {"family", "file", "params", "frame"}, "pattern")
     if ("family" in p) == ("file" in p):
-        raise ConfigError("[pattern] needs exactly one of family or file")
+        raise ConfigError("pattern needs exactly one of family or file")
     if "file" in p:
         import barhinge as bh
 
-        f = Path(p["file"])
+        if "params" in p:
+            raise ConfigError("pattern.params goes with pattern.family, not with pattern.file")
+        f = Path(_check.text(p["file"], "pattern.file"))
         f = f if f.is_absolute() else base / f
-        if "frame" in p:
-            return bh.read_fold(f, frame=int(p["frame"]))
-        return bh.read(f)
+        if not f.is_file():
+            raise ConfigError(f"pattern.file = {str(f)!r} is not a file")
+        try:
+            if "frame" in p:
+                return bh.read_fold(f, frame=_check.integer(p["frame"], "pattern.frame", 0))
+            return bh.read(f)
+        except OSError as exc:
+            raise ConfigError(f"pattern.file = {str(f)!r} cannot be read: {exc.strerror}") from None
+    if "frame" in p:
+        raise ConfigError("pattern.frame goes with pattern.file, not with pattern.family")
     from barhinge.patterns import FAMILIES
 
     fam = p["family"]
-    if fam not in FAMILIES:
-        raise ConfigError(f"pattern family {fam!r} is unknown; expected one of {sorted(FAMILIES)}")
+    if not isinstance(fam, str) or fam not in FAMILIES:
+        raise ConfigError(
+            f"pattern.family = {_check.show(fam)} is unknown; expected one of "
+            f"{', '.join(sorted(FAMILIES))}"
+        )
     params = p.get("params", {})
+    _check_keys(params, set(inspect.signature(FAMILIES[fam]).parameters), "pattern.params")
     gen = FAMILIES[fam]
     sig = inspect.signature(gen)
-    for k in params:
-        if k not in sig.parameters:
-            raise ConfigError(
-                f"unknown key {k!r} in [pattern.params] of family {fam!r}; expected one of "
-                f"{', '.join(sig.parameters)}"
-            )
-    return gen(**params)
+    kw = {
+        k: _param(v, sig.parameters[k].annotation, f"pattern.params.{k}") for k, v in params.items()
+    }
+    try:
+        cp = gen(**kw)
+    except BarhingeError:
+        raise
+    except (TypeError, ValueError, ArithmeticError, IndexError) as exc:
+        raise PatternError(f"pattern family {fam!r} failed with these params: {exc}") from None
+    if not np.isfinite(np.asarray(cp.vertices, float)).all():
+        raise PatternError(
+            f"pattern family {fam!r}: the vertices overflow floating point (params too large)"
+        )
+    return cp
 
 
-def _model_from(cp: Any, m: dict[str, Any]) -> Any:
+def _param(v: Any, annotation: Any, key: str) -> Any:
+    """A pattern-family parameter checked against the generator's annotation."""
+    ann = str(annotation)
+    if ann == "int":
+        return _check.integer(v, key, None, MAX_PATTERN_COUNT)
+    if ann == "bool":
+        return _check.boolean(v, key)
+    if ann.startswith("Sequence[Sequence["):
+        return _check.float_array(v, key, (None, None)).tolist()
+    if ann.startswith("Sequence["):
+        return _check.float_array(v, key, (None,)).tolist()
+    if ann.startswith("float"):
+        return _check.number(v, key)
+    return v
+
+
+def _model_from(cp: Any, m: Any) -> Any:
     from barhinge.model.calibrate import Material
     from barhinge.model.model import BarHingeModel
 
-    m = dict(m)
     sig = inspect.signature(BarHingeModel.from_pattern)
     allowed = (set(sig.parameters) - {"cls", "cp", "pattern", "material"}) | {"material"}
     _check_keys(m, allowed, "model")
+    m = dict(m)
     kw: dict[str, Any] = {}
     if "material" in m:
         mat = m.pop("material")
         fields = {f.name for f in dataclasses.fields(Material)}
         _check_keys(mat, fields, "model.material")
-        kw["material"] = Material(**mat)
+        with _check.prefixed("model.", {"material.E", "material.nu", "material.t"}):
+            kw["material"] = Material(**mat)
     kw.update(m)
-    return BarHingeModel.from_pattern(cp, **kw)
+    with _check.prefixed("model.", allowed):
+        return BarHingeModel.from_pattern(cp, **kw)
 
 
 # ------------------------------------------------------------------------------ default

@@ -32,6 +32,7 @@ import logging
 import numpy as np
 from scipy.optimize import lsq_linear
 
+from barhinge import _check
 from barhinge.errors import ConfigError
 from barhinge.model.topology import Topology
 from barhinge.model.triangulate import Triangulation
@@ -68,7 +69,7 @@ class Material:
     Parameters
     ----------
     E : Young's modulus (force / length^2).
-    nu : Poisson's ratio, in (-1, 0.5].
+    nu : Poisson's ratio, in [0, 0.5).
     t : thickness (length).
     """
 
@@ -77,17 +78,23 @@ class Material:
     t: float = 0.01
 
     def __post_init__(self) -> None:
-        if not self.E > 0:
-            raise ConfigError(f"Material.E = {self.E}; expected > 0")
-        if not -1.0 < self.nu <= 0.5:
-            raise ConfigError(f"Material.nu = {self.nu}; expected in (-1, 0.5]")
-        if not self.t > 0:
-            raise ConfigError(f"Material.t = {self.t}; expected > 0")
+        # E > 0 and t > 0 finite; 0 <= nu < 0.5 (the membrane fit and the F17 bar areas
+        # assume a compressible, non-auxetic sheet; nu -> 0.5 makes bar areas vanish)
+        object.__setattr__(self, "E", _check.number(self.E, "material.E", 0.0, lo_open=True))
+        object.__setattr__(
+            self, "nu", _check.number(self.nu, "material.nu", 0.0, 0.5, hi_open=True)
+        )
+        object.__setattr__(self, "t", _check.number(self.t, "material.t", 0.0, lo_open=True))
+        if not np.isfinite(self.bending_rigidity) or self.bending_rigidity == 0.0:
+            raise ConfigError(
+                f"material.t = {self.t!r} with material.E = {self.E!r}: the bending rigidity "
+                "E t^3 / (12 (1 - nu^2)) is not a positive finite number"
+            )
 
     @property
     def bending_rigidity(self) -> float:
         """Plate bending rigidity ``D = E t^3 / (12 (1 - nu^2))`` (force x length)."""
-        return self.E * self.t**3 / (12.0 * (1.0 - self.nu**2))
+        return self.E * self.t * self.t * self.t / (12.0 * (1.0 - self.nu * self.nu))
 
     def membrane_mandel(self) -> np.ndarray:
         """(3, 3) plane-stress stiffness in Mandel notation (shear entry ``E/(1+nu)``)."""

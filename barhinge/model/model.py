@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
+from barhinge import _check
 from barhinge._typing import SCHEMES, Scheme, StrainMeasure
 from barhinge.assembly import Assembler
 from barhinge.errors import ConfigError
@@ -189,18 +190,29 @@ class BarHingeModel:
             hinge in model order, per fold hinge in model order).
         strain : ``"green"`` or ``"engineering"`` bar strain.
         """
-        if scheme not in SCHEMES:
-            raise ConfigError(f"scheme {scheme!r} is unknown; expected one of {', '.join(SCHEMES)}")
-        if fold_law not in FOLD_LAWS:
-            raise ConfigError(f"fold_law {fold_law!r} is unknown; expected one of {FOLD_LAWS}")
-        if strain not in ("green", "engineering"):
-            raise ConfigError(f"strain {strain!r} is unknown; expected 'green' or 'engineering'")
-        lo, hi = (float(v) for v in fold_limits_deg)
+        _check.choice(scheme, "scheme", SCHEMES)
+        _check.choice(fold_law, "fold_law", FOLD_LAWS)
+        _check.choice(strain, "strain", ("green", "engineering"))
+        _check.choice(bar_calibration, "bar_calibration", ("fit", "filipov"))
+        _check.choice(bend_calibration, "bend_calibration", ("filipov", "kirchhoff", "plate"))
+        lim = _check.float_array(fold_limits_deg, "fold_limits_deg", (2,))
+        lo, hi = float(lim[0]), float(lim[1])
         if not -180.0 < lo < 0.0 < hi < 180.0:
             raise ConfigError(
-                f"fold_limits_deg = {fold_limits_deg}; expected -180 < min < 0 < max < 180"
+                f"fold_limits_deg = {lim.tolist()}; expected -180 < min < 0 < max < 180"
             )
+        if fold_stiffness is not None:
+            fold_stiffness = _check.number(fold_stiffness, "fold_stiffness", 0.0)
+        if crease_length_scale is not None:
+            crease_length_scale = _check.number(
+                crease_length_scale, "crease_length_scale", 0.0, lo_open=True
+            )
+        if stiffness_ratio is not None:
+            stiffness_ratio = _check.number(stiffness_ratio, "stiffness_ratio", 0.0, lo_open=True)
+        bend_coefficient = _check.number(bend_coefficient, "bend_coefficient", 0.0)
         mat = Material() if material is None else material
+        if not isinstance(mat, Material):
+            raise ConfigError(f"material must be a Material, got {type(mat).__name__}")
         tri = triangulate(cp, scheme)
         topo = build_topology(cp, tri)
         X0 = tri.X0
@@ -242,6 +254,18 @@ class BarHingeModel:
             EA = EA * stiffness_ratio
             k[is_bend] *= stiffness_ratio
         rest = hinge_angle(X0, hinges)
+        for what, arr in (
+            ("coordinates", X0),
+            ("bar lengths", L0),
+            ("bar stiffness", EA),
+            ("hinge stiffness", k),
+            ("rest angles", rest),
+        ):
+            if not np.all(np.isfinite(arr)):
+                raise ConfigError(
+                    f"the model has non-finite {what}: the pattern's size or the material "
+                    "constants overflow floating point"
+                )
         return cls(
             pattern=cp,
             scheme=scheme,
@@ -460,9 +484,11 @@ class BarHingeModel:
 
 
 def _override(current: np.ndarray, value: Any, n: int, name: str) -> np.ndarray:
-    v = np.asarray(value, dtype=float)
+    v = _check.float_array(value, name)
     if v.ndim == 0:
-        return np.full(n, float(v))
+        v = np.full(n, float(v))
     if v.shape != (n,):
         raise ConfigError(f"{name} must be a scalar or have shape ({n},), got {v.shape}")
+    if (v < 0).any():
+        raise ConfigError(f"{name} has the entry {v[v < 0][0]}; expected numbers >= 0")
     return v.copy()

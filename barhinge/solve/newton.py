@@ -29,6 +29,8 @@ from barhinge.solve.controls import (
     gdcm_scale,
     gdcm_sign,
 )
+from barhinge.solve.diagnose import check as check_scene
+from barhinge.solve.diagnose import check_finite_tangent
 from barhinge.solve.linear import SingularMatrixError, get_backend
 
 if TYPE_CHECKING:
@@ -83,6 +85,7 @@ class _Driver:
         self.free = ~self.fixed
         if not self.free.any():
             raise ConfigError("every DOF is fixed by supports or prescribed displacements")
+        check_scene(scene)  # separate parts, free rigid-body motions, non-finite input
         self.P = scene.loads.ravel()
         pres = scene.prescribed.ravel()
         self.u_pres = np.where(np.isfinite(pres), pres, 0.0)
@@ -184,6 +187,7 @@ class _Driver:
         (``reuse``: unless the system keeps an earlier factorisation as GMRES
         preconditioner)."""
         self.system.row_scale = self.c_scale
+        check_finite_tangent(e.ev.K)  # NaN / inf never reach the factorisation
         self.system.set_operator(e.ev.K, e.terms, st.mu, self.penalty or 0.0, factorize=not reuse)
 
     def forcing(self, e: _Eval, st: _State, rf: float) -> float:

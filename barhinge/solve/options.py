@@ -5,9 +5,17 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
+from barhinge import _check
 from barhinge.errors import ConfigError
 
 __all__ = ["SolverOptions"]
+
+#: linear solvers (see barhinge.solve.linear)
+LINEAR_SOLVERS = ("auto", "superlu", "cholmod", "pardiso")
+#: upper bound of the iteration-count options (a typo such as 1e9 would never stop)
+MAX_ITERATIONS = 100_000
+#: upper bound of ``max_arc_steps``
+MAX_ARC_STEPS = 10_000_000
 
 
 @dataclasses.dataclass(frozen=True)
@@ -113,40 +121,44 @@ class SolverOptions:
     stability_check: bool | None = None
 
     def __post_init__(self) -> None:
+        # every field: type (bools are not numbers), finiteness and range; messages start
+        # with "options.<field>" (the TOML scene prefixes "solve.")
+        def num(name: str, lo: float, lo_open: bool = True) -> None:
+            v = _check.number(getattr(self, name), f"options.{name}", lo, lo_open=lo_open)
+            object.__setattr__(self, name, v)
+
+        def whole(name: str, lo: int, hi: int) -> None:
+            object.__setattr__(
+                self, name, _check.integer(getattr(self, name), f"options.{name}", lo, hi)
+            )
+
         for name in ("tol_force", "tol_disp", "tol_angle", "divergence_ratio"):
-            v = getattr(self, name)
-            if not (isinstance(v, int | float) and v > 0):
-                raise ConfigError(f"solver option {name} = {v!r}; expected a positive number")
-        for name in ("max_iter", "grow_iters", "krylov_max"):
-            v = getattr(self, name)
-            if not (isinstance(v, int) and v >= 1):
-                raise ConfigError(f"solver option {name} = {v!r}; expected an integer >= 1")
-        if not (isinstance(self.max_cutbacks, int) and self.max_cutbacks >= 0):
-            raise ConfigError(f"solver option max_cutbacks = {self.max_cutbacks!r}; expected >= 0")
-        if self.predictor not in ("secant", "quadratic", "tangent"):
-            raise ConfigError(
-                f"solver option predictor = {self.predictor!r}; "
-                "expected 'secant', 'quadratic' or 'tangent'"
-            )
-        if self.flat_start not in ("rigid", "tangent"):
-            raise ConfigError(
-                f"solver option flat_start = {self.flat_start!r}; expected 'rigid' or 'tangent'"
-            )
-        if not (isinstance(self.line_search, int) and self.line_search >= 0):
-            raise ConfigError(f"solver option line_search = {self.line_search!r}; expected >= 0")
-        if not isinstance(self.reuse_factorization, bool):
-            raise ConfigError(
-                f"solver option reuse_factorization = {self.reuse_factorization!r}; "
-                "expected true or false"
-            )
-        if not (self.stability_check is None or isinstance(self.stability_check, bool)):
-            raise ConfigError(
-                f"solver option stability_check = {self.stability_check!r}; "
-                "expected true, false or omitted"
-            )
-        a = self.augmentation
-        if not (a == "auto" or (isinstance(a, int | float) and a >= 0)):
-            raise ConfigError(f"solver option augmentation = {a!r}; expected 'auto' or >= 0")
+            num(name, 0.0)
+        if self.force_floor is not None:
+            num("force_floor", 0.0, lo_open=False)
+        whole("max_iter", 1, MAX_ITERATIONS)
+        whole("grow_iters", 1, MAX_ITERATIONS)
+        whole("krylov_max", 1, MAX_ITERATIONS)
+        # 2**-60 of a step is below the resolution of the path parameter
+        whole("max_cutbacks", 0, 60)
+        whole("line_search", 0, 60)
+        _check.choice(self.linear_solver, "options.linear_solver", LINEAR_SOLVERS)
+        _check.choice(self.predictor, "options.predictor", ("quadratic", "secant", "tangent"))
+        _check.choice(self.flat_start, "options.flat_start", ("rigid", "tangent"))
+        _check.boolean(self.reuse_factorization, "options.reuse_factorization")
+        if self.stability_check is not None:
+            _check.boolean(self.stability_check, "options.stability_check")
+        if self.augmentation != "auto":
+            if isinstance(self.augmentation, str):
+                raise ConfigError(
+                    f"options.augmentation = {self.augmentation!r}; expected 'auto' or a "
+                    "number >= 0"
+                )
+            num("augmentation", 0.0, lo_open=False)
+        if self.arc_length_increment is not None:
+            num("arc_length_increment", 0.0)
+        if self.max_arc_steps is not None:
+            whole("max_arc_steps", 1, MAX_ARC_STEPS)
 
     def reuses_factorization(self, control: str) -> bool:
         """Whether the solve under ``control`` reuses factorisations (see the option)."""
@@ -162,11 +174,14 @@ class SolverOptions:
     @classmethod
     def from_dict(cls, d: dict[str, Any] | None) -> SolverOptions:
         """Options from a mapping (TOML ``[solve.options]``); unknown keys are errors."""
+        if d is not None and not isinstance(d, dict):
+            raise ConfigError(f"options = {d!r}; expected a table of solver options")
         d = dict(d or {})
         names = {f.name for f in dataclasses.fields(cls)}
         for k in d:
             if k not in names:
                 raise ConfigError(
-                    f"unknown solver option {k!r}; expected one of {', '.join(sorted(names))}"
+                    f"options.{k} is not a solver option; expected one of "
+                    f"{', '.join(sorted(names))}"
                 )
         return cls(**d)
