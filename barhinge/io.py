@@ -20,12 +20,12 @@ import datetime
 import errno
 import glob
 import json
-import tempfile
 import logging
 import os
 import secrets
 import shutil
 import sys
+import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
