@@ -162,6 +162,8 @@ class RigidSolver:
         self.energy_failed = False
         self.branch_attempts = 0
         self.mirrored = False
+        #: (DOF, rank of the actuators on it) at the first folded state, once known
+        self.dof_rank: tuple[int, int] | None = None
         self._Dfree = sp.diags(free.astype(float))
         self._Dact = sp.diags((~free).astype(float))
         self._lu = None
@@ -879,7 +881,9 @@ def rigid_fold(
                 msg, step=s - 1, load_factor=s / steps, residuals=hist_all, last_state=partial(msg)
             )
         if opt.check_actuators and not checked and np.max(np.abs(rho)) >= FLAT_TOL:
-            free_dof = _check_actuators(rc, rho, av, act.edges)
+            k, r = solver.dof_rank or _actuator_rank(rc, rho, av)
+            _log_actuators(k, r, len(av), act.edges)
+            free_dof = k - r
             checked = True
         states.append(rho.copy())
         iters.append(solver.iterations)
@@ -953,7 +957,8 @@ def _advance(
             new = np.zeros_like(new)
         if ok and np.max(np.abs(new), initial=0.0) >= FLAT_TOL:
             if solver.underactuated is None:
-                solver.underactuated = _free_motions(solver.rc, new, solver.act) > 0
+                solver.dof_rank = _actuator_rank(solver.rc, new, solver.act)
+                solver.underactuated = solver.dof_rank[0] > solver.dof_rank[1]
             if solver.underactuated:
                 new, ok = solver.minimize(new)
                 if not ok:
@@ -1036,25 +1041,17 @@ def _dependent_actuators(
     )
 
 
-def _free_motions(rc: RigidConstraints, rho: np.ndarray, av: np.ndarray) -> int:
-    """Number of motions the actuators ``av`` leave free at the folded state ``rho``:
-    the DOF (nullity of the Jacobian) minus the rank of the actuator rows of its null
-    space."""
+def _actuator_rank(rc: RigidConstraints, rho: np.ndarray, av: np.ndarray) -> tuple[int, int]:
+    """(DOF, rank of the actuators on it) at the folded state ``rho``: the nullity of the
+    Jacobian and the rank of the actuator rows of its null-space basis; ``DOF - rank``
+    motions are left free (resolved by the fold-spring energy)."""
     ns = null_space(rc.jacobian(rho))
     NA = ns.basis[av]
     r = int(np.linalg.matrix_rank(NA, tol=1e-8)) if NA.size else 0
-    return ns.basis.shape[1] - r
+    return ns.basis.shape[1], r
 
 
-def _check_actuators(
-    rc: RigidConstraints, rho: np.ndarray, av: np.ndarray, edges: np.ndarray
-) -> int:
-    """Free motions the actuators leave at the folded state ``rho`` (resolved by the
-    fold-spring energy); logs when they over-determine the motion."""
-    ns = null_space(rc.jacobian(rho))
-    k = ns.basis.shape[1]
-    NA = ns.basis[av]
-    r = int(np.linalg.matrix_rank(NA, tol=1e-8)) if NA.size else 0
+def _log_actuators(k: int, r: int, n_act: int, edges: np.ndarray) -> None:
     if r < k:
         log.info(
             "the actuators %s fix %d of the %d DOF; the other %d are resolved by minimising "
@@ -1064,13 +1061,12 @@ def _check_actuators(
             k,
             k - r,
         )
-    if len(av) > r:
+    if n_act > r:
         log.info(
             "actuators %s over-determine the motion (DOF %d): targets must stay compatible",
             edges.tolist(),
             k,
         )
-    return k - r
 
 
 def _make_path(
