@@ -9,10 +9,10 @@ import pytest
 import scipy.sparse as sp
 
 import barhinge as bh
+from barhinge.linalg.backends import available_backends, get_backend
 from barhinge.model.model import BarHingeModel
 from barhinge.scene import Scene, miura_line_creases
 from barhinge.solve.controls import BorderedSystem, Timer, actuator_terms
-from barhinge.solve.linear import available_backends, get_backend
 from barhinge.solve.options import SolverOptions
 
 
