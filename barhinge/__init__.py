@@ -29,7 +29,7 @@ _LAZY = {
     "dof": "barhinge.kinematics.dof",
     "rigid_fold": "barhinge.kinematics.path",
     "BarHingeModel": "barhinge.model.model",
-    "Material": "barhinge.model.calibrate",
+    "Material": "barhinge.model.material",
     "Scene": "barhinge.scene",
     "load_scene": "barhinge.scene",
     "solve": "barhinge.solve.newton",

@@ -524,7 +524,7 @@ def _param(v: Any, annotation: Any, key: str) -> Any:
 
 
 def _model_from(cp: Any, m: Any) -> Any:
-    from barhinge.model.calibrate import Material
+    from barhinge.model.material import Material
     from barhinge.model.model import BarHingeModel
 
     sig = inspect.signature(BarHingeModel.from_pattern)
@@ -564,7 +564,7 @@ def default_scene(nx: int = 6, ny: int = 6, steps: int = 30) -> Scene:
 
 
 def _default_model(cp: Any) -> Any:
-    from barhinge.model.calibrate import Material
+    from barhinge.model.material import Material
     from barhinge.model.model import BarHingeModel
 
     return BarHingeModel.from_pattern(

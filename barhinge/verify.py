@@ -197,7 +197,7 @@ def summary(checks: Sequence[Check]) -> dict[str, object]:
 
 # =============================================================================== helpers
 def _material():
-    from barhinge.model.calibrate import Material
+    from barhinge.model.material import Material
 
     return Material(E=1.0e6, nu=0.3, t=0.01)
 

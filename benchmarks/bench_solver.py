@@ -31,7 +31,7 @@ import numpy as np
 
 import barhinge as bh
 from barhinge.linalg.backends import get_backend
-from barhinge.model.calibrate import Material
+from barhinge.model.material import Material
 from barhinge.model.model import BarHingeModel
 from barhinge.scene import Scene, miura_line_creases
 from barhinge.solve.controls import BorderedSystem, Timer, actuator_terms
