@@ -463,7 +463,8 @@ def _pattern_from(p: Any, base: Path) -> Any:
     if ("family" in p) == ("file" in p):
         raise ConfigError("pattern needs exactly one of family or file")
     if "file" in p:
-        import barhinge as bh
+        from barhinge.pattern.fold import read_fold
+        from barhinge.pattern.io import read
 
         if "params" in p:
             raise ConfigError("pattern.params goes with pattern.family, not with pattern.file")
@@ -473,8 +474,8 @@ def _pattern_from(p: Any, base: Path) -> Any:
             raise ConfigError(f"pattern.file = {str(f)!r} is not a file")
         try:
             if "frame" in p:
-                return bh.read_fold(f, frame=_check.integer(p["frame"], "pattern.frame", 0))
-            return bh.read(f)
+                return read_fold(f, frame=_check.integer(p["frame"], "pattern.frame", 0))
+            return read(f)
         except OSError as exc:
             raise ConfigError(f"pattern.file = {str(f)!r} cannot be read: {exc.strerror}") from None
     if "frame" in p:
