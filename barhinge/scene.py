@@ -22,7 +22,7 @@ from barhinge import _check
 from barhinge._typing import ControlKind
 from barhinge.actuators import Actuators
 from barhinge.errors import BarhingeError, ConfigError, PatternError
-from barhinge.solve.options import SolverOptions
+from barhinge.solver_options import SolverOptions
 
 __all__ = [
     "Scene",

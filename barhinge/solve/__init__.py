@@ -5,8 +5,9 @@ arc-length control (the factorisation backends are in :mod:`barhinge.linalg`).
 once the sub-package is imported Python binds ``barhinge.solve`` to it, so the module is made
 callable and forwards to the function (``bh.solve(scene)`` works either way).
 
-Nothing is imported eagerly: :class:`~barhinge.solve.options.SolverOptions` is plain data that
-a :class:`~barhinge.scene.Scene` carries, and importing it must not load the Newton driver.
+Nothing is imported eagerly, so importing a module of the solver (or ``barhinge.solve`` for
+:class:`~barhinge.solver_options.SolverOptions`, kept here for convenience; it lives below the
+scene) does not load the Newton driver before it is needed.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from typing import Any
 __all__ = ["SolverOptions", "solve"]
 
 # name -> module that defines it (imported on first use)
-_LAZY = {"solve": "barhinge.solve.newton", "SolverOptions": "barhinge.solve.options"}
+_LAZY = {"solve": "barhinge.solve.newton", "SolverOptions": "barhinge.solver_options"}
 
 
 def __getattr__(name: str) -> Any:

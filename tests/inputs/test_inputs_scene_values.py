@@ -240,7 +240,7 @@ def test_actuators_reject_float_and_bool_edges_and_bad_targets():
 
 
 def test_solver_options_check_every_field():
-    from barhinge.solve.options import SolverOptions
+    from barhinge.solver_options import SolverOptions
 
     for kw in [
         {"max_iter": True},

@@ -31,7 +31,7 @@ from barhinge.model.model import BarHingeModel
 from barhinge.scene import Scene, miura_line_creases
 from barhinge.solve import newton
 from barhinge.solve.controls import BorderedSystem, Timer, actuator_terms
-from barhinge.solve.options import SolverOptions
+from barhinge.solver_options import SolverOptions
 from barhinge.verify import von_mises_limit_load, von_mises_model
 
 H_VM = 0.3  # rise of barhinge.verify's von Mises truss

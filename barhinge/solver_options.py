@@ -1,4 +1,5 @@
-"""Solver options (tolerances, step control, linear backend)."""
+"""Solver options (tolerances, step control, linear backend): plain data that a
+:class:`~barhinge.scene.Scene` carries and :func:`barhinge.solve` reads, so it sits below both."""
 
 from __future__ import annotations
 
