@@ -9,12 +9,11 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
+from barhinge._version import __version__ as __version__
 from barhinge.actuators import Actuators
 from barhinge.errors import BarhingeError, ConfigError, ConvergenceError, PatternError
 from barhinge.pattern.crease import CreasePattern
 from barhinge.results import FoldPath
-
-__version__ = "0.1.0"
 
 # name -> module that defines it (imported on first use)
 _LAZY = {
@@ -29,7 +28,7 @@ _LAZY = {
     "dof": "barhinge.kinematics.dof",
     "rigid_fold": "barhinge.kinematics.path",
     "BarHingeModel": "barhinge.model.model",
-    "Material": "barhinge.model.calibrate",
+    "Material": "barhinge.model.material",
     "Scene": "barhinge.scene",
     "load_scene": "barhinge.scene",
     "solve": "barhinge.solve.newton",

@@ -103,24 +103,3 @@ class Actuators:
             return np.vstack([start, self.table_deg])
         s = np.linspace(0.0, 1.0, steps + 1)[:, None]
         return start[None, :] + s * (self.targets_deg - start)[None, :]
-
-
-# Control curves live in barhinge.control (they import Actuators); re-exported lazily here.
-_CONTROL = (
-    "CircularArc",
-    "Parabola",
-    "SplineCurve",
-    "curve_actuators",
-    "curve_schedule",
-    "synchronised",
-    "spaced_lines",
-    "chain_on_curve",
-)
-
-
-def __getattr__(name: str) -> object:
-    if name in _CONTROL:
-        from barhinge import control
-
-        return getattr(control, name)
-    raise AttributeError(f"module 'barhinge.actuators' has no attribute {name!r}")

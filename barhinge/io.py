@@ -720,7 +720,7 @@ def result_folder(
     ConfigError
         ``out`` may not receive a run (see :func:`check_output_folder`).
     """
-    from barhinge import __version__
+    from barhinge._version import __version__
 
     out = check_output_folder(out, overwrite=overwrite)
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -22,7 +22,7 @@ from barhinge import _check
 from barhinge._typing import ControlKind
 from barhinge.actuators import Actuators
 from barhinge.errors import BarhingeError, ConfigError, PatternError
-from barhinge.solve.options import SolverOptions
+from barhinge.solver_options import SolverOptions
 
 __all__ = [
     "Scene",
@@ -463,7 +463,8 @@ def _pattern_from(p: Any, base: Path) -> Any:
     if ("family" in p) == ("file" in p):
         raise ConfigError("pattern needs exactly one of family or file")
     if "file" in p:
-        import barhinge as bh
+        from barhinge.pattern.fold import read_fold
+        from barhinge.pattern.io import read
 
         if "params" in p:
             raise ConfigError("pattern.params goes with pattern.family, not with pattern.file")
@@ -473,8 +474,8 @@ def _pattern_from(p: Any, base: Path) -> Any:
             raise ConfigError(f"pattern.file = {str(f)!r} is not a file")
         try:
             if "frame" in p:
-                return bh.read_fold(f, frame=_check.integer(p["frame"], "pattern.frame", 0))
-            return bh.read(f)
+                return read_fold(f, frame=_check.integer(p["frame"], "pattern.frame", 0))
+            return read(f)
         except OSError as exc:
             raise ConfigError(f"pattern.file = {str(f)!r} cannot be read: {exc.strerror}") from None
     if "frame" in p:
@@ -524,7 +525,7 @@ def _param(v: Any, annotation: Any, key: str) -> Any:
 
 
 def _model_from(cp: Any, m: Any) -> Any:
-    from barhinge.model.calibrate import Material
+    from barhinge.model.material import Material
     from barhinge.model.model import BarHingeModel
 
     sig = inspect.signature(BarHingeModel.from_pattern)
@@ -564,7 +565,7 @@ def default_scene(nx: int = 6, ny: int = 6, steps: int = 30) -> Scene:
 
 
 def _default_model(cp: Any) -> Any:
-    from barhinge.model.calibrate import Material
+    from barhinge.model.material import Material
     from barhinge.model.model import BarHingeModel
 
     return BarHingeModel.from_pattern(

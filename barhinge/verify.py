@@ -24,6 +24,22 @@ from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
+from barhinge import patterns
+from barhinge.actuators import Actuators
+from barhinge.analysis.curvature import angle_defect, gaussian_curvature
+from barhinge.analysis.poisson import grid_pairs, periodic_poisson
+from barhinge.analysis.stiffness import effective_stiffness
+from barhinge.errors import ConfigError
+from barhinge.kinematics.dof import dof
+from barhinge.kinematics.path import rigid_fold
+from barhinge.model.material import Material
+from barhinge.model.model import BarHingeModel
+from barhinge.pattern.crease import CreasePattern
+from barhinge.patterns.miura import miura_layout
+from barhinge.patterns.properties import maekawa_count
+from barhinge.scene import Scene
+from barhinge.solve.newton import solve
+
 __all__ = ["CASES", "Case", "Check", "Quantity", "run", "summary"]
 
 log = logging.getLogger(__name__)
@@ -161,7 +177,6 @@ def run(
     on_case : callable, optional
         Called after each case with its rows (progress display).
     """
-    from barhinge.errors import ConfigError
 
     pool = list(CASES.values()) if cases is None else list(cases)
     if names:
@@ -197,7 +212,6 @@ def summary(checks: Sequence[Check]) -> dict[str, object]:
 
 # =============================================================================== helpers
 def _material():
-    from barhinge.model.calibrate import Material
 
     return Material(E=1.0e6, nu=0.3, t=0.01)
 
@@ -250,26 +264,21 @@ _SG_CITE = "Schenk & Guest 2013, PNAS 110(9):3276, Eq. 1-2"
 def _miura_rigid() -> dict[str, float]:
     """Rigid path of one flat Miura cell, driven by its first interior zig-zag crease to
     -2 theta (the zig-zag fold angle of S&G's theta), then theta +- 0.05 deg for nu_SL."""
-    import barhinge as bh
-    from barhinge.patterns.miura import miura_layout
 
-    cp = bh.patterns.miura(1, 1, a=_MA, b=_MB, alpha=_MG)
+    cp = patterns.miura(1, 1, a=_MA, b=_MB, alpha=_MG)
     lay = miura_layout(1, 1)
     ez = int(lay.interior_zigzag_edges[0])
     es = int(lay.interior_straight_edges[0])
     sign = math.copysign(1.0, float(cp.fold_angles[ez]))
     d = 0.05
     tab = np.r_[np.linspace(10.0, 2 * (_MT - d), 5), 2 * _MT, 2 * (_MT + d)]
-    path = bh.rigid_fold(
-        cp, bh.Actuators(edges=[ez], table_deg=sign * tab[:, None]), steps=len(tab)
-    )
+    path = rigid_fold(cp, Actuators(edges=[ez], table_deg=sign * tab[:, None]), steps=len(tab))
     out = _miura_dims(path.X[-2], lay.ni)
     out["rho_straight_deg"] = abs(float(path.fold_angles_deg[-2, es]))
     lo, hi = _miura_dims(path.X[-3], lay.ni), _miura_dims(path.X[-1], lay.ni)
     # central difference of ln L against ln S (error O(d^2) ~ 1e-6)
     out["nu_SL"] = -math.log(hi["L"] / lo["L"]) / math.log(hi["S"] / lo["S"])
     # the same through the library's analysis (pairs one period apart, np.gradient)
-    from barhinge.analysis.poisson import grid_pairs, periodic_poisson
 
     pairs_L, pairs_S = grid_pairs(cp)
     out["nu_SL_analysis"] = float(periodic_poisson(path, pairs_S, pairs_L).nu[-2])
@@ -282,7 +291,7 @@ _miura_rigid_case = Case(
     name="miura_rigid",
     citation=_SG_CITE,
     description=(
-        "Rigid folding path (bh.rigid_fold) of a flat 1x1 Miura cell (a=1, b=1.5, "
+        "Rigid folding path (rigid_fold) of a flat 1x1 Miura cell (a=1, b=1.5, "
         "gamma=60 deg) to theta=50 deg; cell dimensions measured frame-free from the vertices"
     ),
     compute=_miura_rigid,
@@ -315,20 +324,14 @@ _miura_rigid_case = Case(
 def _miura_barhinge() -> dict[str, float]:
     """Bar-and-hinge (N5B8) model of the same cell, bars and bending stiffened 1000x relative
     to the folds, folded by fold-angle control of the same zig-zag crease."""
-    import barhinge as bh
-    from barhinge.patterns.miura import miura_layout
 
-    cp = bh.patterns.miura(1, 1, a=_MA, b=_MB, alpha=_MG)
+    cp = patterns.miura(1, 1, a=_MA, b=_MB, alpha=_MG)
     lay = miura_layout(1, 1)
     ez = int(lay.interior_zigzag_edges[0])
     sign = math.copysign(1.0, float(cp.fold_angles[ez]))
-    model = bh.BarHingeModel.from_pattern(
-        cp, scheme="N5B8", material=_material(), stiffness_ratio=1e3
-    )
-    scene = bh.Scene(
-        model, actuators=bh.Actuators(edges=[ez], targets_deg=[sign * 2 * _MT]), steps=8
-    )
-    path = bh.solve(scene)
+    model = BarHingeModel.from_pattern(cp, scheme="N5B8", material=_material(), stiffness_ratio=1e3)
+    scene = Scene(model, actuators=Actuators(edges=[ez], targets_deg=[sign * 2 * _MT]), steps=8)
+    path = solve(scene)
     return _miura_dims(path.X[-1], lay.ni)
 
 
@@ -337,7 +340,7 @@ _miura_bh_case = Case(
     name="miura_barhinge_rigid_limit",
     citation=_SG_CITE,
     description=(
-        "bh.solve, fold-angle control, N5B8 Miura cell with stiffness_ratio=1e3 (rigid-panel "
+        "solve, fold-angle control, N5B8 Miura cell with stiffness_ratio=1e3 (rigid-panel "
         "limit of Filipov et al. 2017), folded to theta=50 deg"
     ),
     compute=_miura_barhinge,
@@ -350,7 +353,7 @@ _miura_bh_case = Case(
 )
 
 # 3 x 3 Miura sheet (a = b = 1, gamma = 60 deg) folded from flat to half its pattern target:
-# the zig-zag creases' target is 2 x 60 deg (bh.patterns.miura's default theta), half of it
+# the zig-zag creases' target is 2 x 60 deg (patterns.miura's default theta), half of it
 # is S&G's theta = 30 deg.
 _FS_N, _FS_THETA, _FS_RATIOS, _FS_STEPS = 3, 30.0, (1e4, 1e5), 6
 _FS_SG = _sg_closed_forms(1.0, 1.0, _MG, _FS_THETA)
@@ -375,10 +378,9 @@ def _multi_cell_flat_start(flat_start: str = "rigid") -> dict[str, float]:
     M/V assignment at any state of either run; at 1e5 the zig-zag and straight crease
     farthest from the rigid closed forms; the observed order of the gap between the two
     ratios. ``flat_start`` is the solver option (the tests show "tangent" fails the case)."""
-    import barhinge as bh
 
-    cp = bh.patterns.miura(_FS_N, _FS_N, alpha=_MG)
-    lay = bh.patterns.miura_layout(_FS_N, _FS_N)
+    cp = patterns.miura(_FS_N, _FS_N, alpha=_MG)
+    lay = patterns.miura_layout(_FS_N, _FS_N)
     ez = int(lay.interior_zigzag_edges[0])
     target = 0.5 * float(cp.fold_angles[ez])
     if abs(abs(target) - 2 * _FS_THETA) > 1e-9:
@@ -388,16 +390,16 @@ def _multi_cell_flat_start(flat_start: str = "rigid") -> dict[str, float]:
     against: set[int] = set()
     gaps = {}
     for ratio in _FS_RATIOS:
-        model = bh.BarHingeModel.from_pattern(
+        model = BarHingeModel.from_pattern(
             cp, scheme="N5B8", material=_material(), stiffness_ratio=ratio
         )
-        scene = bh.Scene(
+        scene = Scene(
             model,
-            actuators=bh.Actuators(edges=[ez], targets_deg=[target]),
+            actuators=Actuators(edges=[ez], targets_deg=[target]),
             steps=_FS_STEPS,
             options={"flat_start": flat_start},
         )
-        path = bh.solve(scene)
+        path = solve(scene)
         against.update(np.flatnonzero((want * path.fold_angles_deg < -1e-6).any(axis=0)))
         gaps[ratio] = _flat_start_gaps(path.fold_angles_deg[-1], want, lay)
     g = gaps[_FS_RATIOS[-1]]
@@ -424,7 +426,7 @@ _flat_start_case = Case(
         "Schenk & Paulino 2017, IJSS 124:26"
     ),
     description=(
-        "bh.solve from the exact flat state, fold-angle control of one interior zig-zag crease "
+        "solve from the exact flat state, fold-angle control of one interior zig-zag crease "
         "to half its pattern target (theta = 30 deg) in 6 steps; 3x3 Miura (gamma = 60 deg), "
         "N5B8, Material(E=1e6, nu=0.3, t=0.01), stiffness ratios 1e4 and 1e5"
     ),
@@ -461,7 +463,6 @@ def degree4_pattern(fold_angles=None):
     """A flat-foldable degree-4 vertex, sector angles 70, 50, 110, 130 deg; creases 0..3 at
     directions 0, 70, 120, 230 deg, boundary edges 4..7. Assignment M V M M (first branch);
     with ``fold_angles`` (target angles of creases 0..3, choosing a branch) M M V M."""
-    from barhinge.pattern.crease import CreasePattern
 
     a, b = math.radians(_D4A), math.radians(_D4B)
     dirs = [0.0, a, a + b, math.pi + b]
@@ -481,16 +482,15 @@ _RHO1 = -40.0  # degrees, crease 1 (direction 0, between sectors pi - beta and a
 def _degree4() -> dict[str, float]:
     """Rigid path of a single degree-4 vertex driven by crease 1 to -40 deg, once on each of
     its two folding modes (mode 2 chosen by target fold angles: explicit branch choice)."""
-    import barhinge as bh
 
     out = {}
-    p1 = bh.rigid_fold(degree4_pattern(), [0], targets_deg=[_RHO1], steps=6)
+    p1 = rigid_fold(degree4_pattern(), [0], targets_deg=[_RHO1], steps=6)
     r = np.radians(p1.fold_angles_deg[-1, :4])
     out["mode1_multiplier"] = math.tan(r[1] / 2) / math.tan(r[0] / 2)
     q = _mult2()
     r2 = math.degrees(2 * math.atan(q * math.tan(math.radians(-20.0) / 2)))
     cp2 = degree4_pattern([-20.0, r2, 20.0, r2])  # branch direction, not the result
-    p2 = bh.rigid_fold(cp2, [0], targets_deg=[_RHO1], steps=6)
+    p2 = rigid_fold(cp2, [0], targets_deg=[_RHO1], steps=6)
     r = np.radians(p2.fold_angles_deg[-1, :4])
     out["mode2_multiplier"] = math.tan(r[1] / 2) / math.tan(r[0] / 2)
     return out
@@ -533,11 +533,9 @@ _degree4_case = Case(
 def _maekawa_kawasaki() -> dict[str, float]:
     """|#M - #V| and the alternate sector-angle sum at every interior vertex of flat
     Miura (gamma = 60 deg) and Yoshimura sheets; the worst vertex is reported."""
-    import barhinge as bh
-    from barhinge.patterns.properties import maekawa_count
 
     m, kw = [], []
-    for cp in (bh.patterns.miura(2, 2, alpha=_MG), bh.patterns.yoshimura(4, 2)):
+    for cp in (patterns.miura(2, 2, alpha=_MG), patterns.yoshimura(4, 2)):
         m.extend(np.abs(maekawa_count(cp)[cp.interior_vertices]).tolist())
         for v in cp.interior_vertices:
             sec = np.asarray(cp.sector_angles[v])
@@ -582,9 +580,7 @@ def _icosahedron() -> tuple[np.ndarray, np.ndarray]:
 
 def _curvature() -> dict[str, float]:
     """Angle defects of a closed polyhedron; global-form curvature of sphere and saddle
-    samples (bh.gaussian_curvature, local quadratic fits)."""
-    import barhinge as bh
-    from barhinge.analysis.curvature import angle_defect
+    samples (gaussian_curvature, local quadratic fits)."""
 
     X, T = _icosahedron()
     X = X * (1.0 + 0.05 * np.sin(np.arange(len(X))))[:, None]  # not regular: any polyhedron
@@ -594,9 +590,9 @@ def _curvature() -> dict[str, float]:
     x, y = (a.ravel() for a in np.meshgrid(g, g))
     centre = int(np.argmin(x * x + y * y))
     sphere = np.column_stack([x, y, R - np.sqrt(R * R - x * x - y * y)])
-    out["K_sphere"] = float(bh.gaussian_curvature(sphere).K[centre])
+    out["K_sphere"] = float(gaussian_curvature(sphere).K[centre])
     saddle = np.column_stack([x, y, (x * x - y * y) / (2 * R)])
-    out["K_saddle"] = float(bh.gaussian_curvature(saddle).K[centre])
+    out["K_saddle"] = float(gaussian_curvature(saddle).K[centre])
     return out
 
 
@@ -619,10 +615,9 @@ _curvature_case = Case(
 
 
 def _dof() -> dict[str, float]:
-    import barhinge as bh
 
-    cp = bh.patterns.miura(3, 3, alpha=_MG)
-    rep = bh.dof(cp)
+    cp = patterns.miura(3, 3, alpha=_MG)
+    rep = dof(cp)
     fold = rep.folded if rep.folded is not None else rep
     n_e = int(np.isin(cp.assignment, ["M", "V"]).sum())
     n_v = len(cp.interior_vertices)
@@ -637,7 +632,7 @@ _dof_case = Case(
     name="dof_miura",
     citation="Tachi 2010, 'Geometric considerations for the design of rigid origami "
     "structures', IASS (DOF = E_in - 3 V_in); Schenk & Guest 2013 (Miura: one DOF)",
-    description="bh.dof of a 3x3 Miura sheet: counted DOF and the rank DOF at a folded state",
+    description="dof of a 3x3 Miura sheet: counted DOF and the rank DOF at a folded state",
     compute=_dof,
     quantities=(
         # 3x3 Miura: E_in = 5*6 + 5*6 = 60... counted by hand: rows 5 x 6 + columns 5 x 6
@@ -657,20 +652,16 @@ _RHO_ACT = 90.0
 def _fold_moment() -> dict[str, float]:
     """Two square panels joined by one crease of length 1, folded to 90 deg by fold-angle
     control: the actuator moment equals the hinge's linear law."""
-    import barhinge as bh
-    from barhinge.pattern.crease import CreasePattern
 
     V = [[-1, 0], [0, 0], [1, 0], [1, 1], [0, 1], [-1, 1]]
     E = [[0, 1], [1, 2], [2, 3], [3, 4], [4, 5], [5, 0], [1, 4]]
     cp = CreasePattern(
         vertices=V, edges=E, assignment=list("BBBBBBV"), faces=[[0, 1, 4, 5], [1, 2, 3, 4]]
     )
-    model = bh.BarHingeModel.from_pattern(
+    model = BarHingeModel.from_pattern(
         cp, scheme="N4B5", material=_material(), fold_stiffness=_K_FOLD
     )
-    path = bh.solve(
-        bh.Scene(model, actuators=bh.Actuators(edges=[6], targets_deg=[_RHO_ACT]), steps=4)
-    )
+    path = solve(Scene(model, actuators=Actuators(edges=[6], targets_deg=[_RHO_ACT]), steps=4))
     return {"actuator_moment": float(path.actuator_moments[-1, 0])}
 
 
@@ -678,7 +669,7 @@ _fold_case = Case(
     name="fold_actuator_moment",
     citation="Liu & Paulino 2017, Proc. R. Soc. A 473:20170348 (linear hinge "
     "M = k L (rho - rho0)); Filipov et al. 2017 IJSS 124:26",
-    description="Two 1x1 panels, one crease (L=1, k=2), bh.solve fold-angle control to 90 deg",
+    description="Two 1x1 panels, one crease (L=1, k=2), solve fold-angle control to 90 deg",
     compute=_fold_moment,
     quantities=(
         Quantity(
@@ -696,9 +687,6 @@ def _hinge_cantilever() -> dict[str, float]:
     stiffness (barhinge.analysis.stiffness.effective_stiffness) of the free edge. The panel
     also bends along its diagonal, a compliance proportional to 1/ratio (ratio = panel / fold
     stiffness): computed at ratios 1e4 and 1e5 and extrapolated to the rigid panel."""
-    import barhinge as bh
-    from barhinge.analysis.stiffness import effective_stiffness
-    from barhinge.pattern.crease import CreasePattern
 
     V = [[-1, 0], [0, 0], [1, 0], [1, 1], [0, 1], [-1, 1]]
     E = [[0, 1], [1, 2], [2, 3], [3, 4], [4, 5], [5, 0], [1, 4]]
@@ -707,7 +695,7 @@ def _hinge_cantilever() -> dict[str, float]:
     )
     k = []
     for ratio in (1e4, 1e5):
-        model = bh.BarHingeModel.from_pattern(
+        model = BarHingeModel.from_pattern(
             cp, scheme="N4B5", material=_material(), fold_stiffness=_K_FOLD, stiffness_ratio=ratio
         )
         fixed = np.zeros((model.n_nodes, 3), bool)
@@ -749,8 +737,6 @@ _SW, _SH, _SN = 1.0, 1.2, 4  # strip of 4 panels 1 x 1.2 (x by y)
 def _membrane_strip() -> dict[str, float]:
     """Strip of 4 rectangular N5B8 panels (F17 bars), left edge held in x (one node also
     in y), all nodes held in z, pulled at the right edge by a tiny load; axial stiffness."""
-    import barhinge as bh
-    from barhinge.pattern.crease import CreasePattern
 
     n = _SN
     V = [[i * _SW, j * _SH] for j in (0, 1) for i in range(n + 1)]
@@ -760,9 +746,7 @@ def _membrane_strip() -> dict[str, float]:
     asg = ["B"] * (2 * n) + ["B"] + ["F"] * (n - 1) + ["B"]
     cp = CreasePattern(vertices=V, edges=edges, assignment=asg, faces=faces)
     mat = _material()
-    model = bh.BarHingeModel.from_pattern(
-        cp, scheme="N5B8", material=mat, bar_calibration="filipov"
-    )
+    model = BarHingeModel.from_pattern(cp, scheme="N5B8", material=mat, bar_calibration="filipov")
     nn = model.n_nodes
     S = np.zeros((nn, 3), bool)
     S[:, 2] = True
@@ -772,7 +756,7 @@ def _membrane_strip() -> dict[str, float]:
     P = np.zeros((nn, 3))
     F = 1e-6 * mat.E * mat.t * _SH  # strain 1e-6: geometric nonlinearity ~1e-6
     P[right, 0] = F / 2
-    path = bh.solve(bh.Scene(model, supports=S, loads=P, control="load", steps=1))
+    path = solve(Scene(model, supports=S, loads=P, control="load", steps=1))
     u = float(path.X[-1, right, 0].mean() - model.X0[right, 0].mean())
     return {"axial_stiffness": F / u}
 
@@ -794,8 +778,6 @@ _strip_case = Case(
 
 
 def _filipov_areas() -> dict[str, float]:
-    import barhinge as bh
-    from barhinge.pattern.crease import CreasePattern
 
     W, H = 1.0, 1.2
     cp = CreasePattern(
@@ -805,7 +787,7 @@ def _filipov_areas() -> dict[str, float]:
         faces=[[0, 1, 2, 3]],
     )
     mat = _material()
-    m = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=mat, bar_calibration="filipov")
+    m = BarHingeModel.from_pattern(cp, scheme="N5B8", material=mat, bar_calibration="filipov")
     A = np.asarray(m.bar_EA) / mat.E
     L = np.asarray(m.bar_L0)
     pick = lambda length: float(A[np.argmin(np.abs(L - length))])  # noqa: E731
@@ -845,8 +827,6 @@ def von_mises_model(a: float = _VMA, h: float = _VMH, EA: float = _VMEA, spring:
 
     Returns (model, supports (n, 3) bool, apex node id).
     """
-    import barhinge as bh
-    from barhinge.pattern.crease import CreasePattern
 
     if spring <= 0:
         cp = CreasePattern(
@@ -855,7 +835,7 @@ def von_mises_model(a: float = _VMA, h: float = _VMH, EA: float = _VMEA, spring:
             assignment=list("BBB"),
             faces=[[0, 1, 2]],
         )
-        model = bh.BarHingeModel.from_pattern(cp, scheme="N4B5", bar_EA=EA)
+        model = BarHingeModel.from_pattern(cp, scheme="N4B5", bar_EA=EA)
     else:
         cp = CreasePattern(
             vertices=[[-a, 0, 0], [a, 0, 0], [0, 0, h], [0, 0, 2 * h]],
@@ -863,7 +843,7 @@ def von_mises_model(a: float = _VMA, h: float = _VMH, EA: float = _VMEA, spring:
             assignment=list("BBFBB"),
             faces=[[0, 1, 2], [0, 2, 3]],
         )
-        m0 = bh.BarHingeModel.from_pattern(cp, scheme="N4B5", bar_EA=EA, fold_stiffness=0.0)
+        m0 = BarHingeModel.from_pattern(cp, scheme="N4B5", bar_EA=EA, fold_stiffness=0.0)
         bars = np.sort(np.asarray(m0.bars), axis=1).tolist()
         EAs = np.full(len(bars), EA)
         EAs[bars.index([2, 3])] = spring * h
@@ -885,17 +865,16 @@ def von_mises_limit_load(a: float = _VMA, h: float = _VMH, EA: float = _VMEA) ->
 def _von_mises() -> dict[str, float]:
     """Arc length (MGDCM) through the snap-through of the von Mises truss; the first peak of
     the load factor refined by a parabola through the three states around it."""
-    import barhinge as bh
 
     model, S, apex = von_mises_model()
     Pmax = von_mises_limit_load()
     P = np.zeros((model.n_nodes, 3))
     P[apex, 2] = -1.5 * Pmax
-    scene = bh.Scene(
+    scene = Scene(
         model, supports=S, loads=P, control="arc_length", steps=20,
         options={"max_arc_steps": 200},
     )  # fmt: skip
-    path = bh.solve(scene)
+    path = solve(scene)
     lam = path.load_factor
     k = int(np.argmax(np.diff(lam) < 0))
     z = path.X[:, apex, 2]

@@ -30,11 +30,11 @@ import time
 import numpy as np
 
 import barhinge as bh
-from barhinge.model.calibrate import Material
+from barhinge.linalg.backends import get_backend
+from barhinge.model.material import Material
 from barhinge.model.model import BarHingeModel
 from barhinge.scene import Scene, miura_line_creases
 from barhinge.solve.controls import BorderedSystem, Timer, actuator_terms
-from barhinge.solve.linear import get_backend
 
 
 def _stiffness_model(cp, material: str) -> BarHingeModel:

@@ -33,7 +33,7 @@ import scipy.sparse as sp
 
 from barhinge.errors import ConfigError, PatternError
 from barhinge.kinematics.constraints import RigidConstraints
-from barhinge.kinematics.linalg import DENSE_LIMIT, NullSpace, null_space
+from barhinge.linalg.nullspace import DENSE_LIMIT, NullSpace, null_space
 from barhinge.pattern.crease import CreasePattern
 
 __all__ = ["DofReport", "dof", "select_actuators", "folded_sample"]

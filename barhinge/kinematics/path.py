@@ -47,10 +47,10 @@ from barhinge.actuators import Actuators
 from barhinge.errors import ConfigError, ConvergenceError
 from barhinge.kinematics.constraints import RigidConstraints
 from barhinge.kinematics.dof import FLAT_TOL, _branch_direction
-from barhinge.kinematics.linalg import DENSE_TOL, null_space
+from barhinge.linalg.backends import SingularMatrixError, get_backend
+from barhinge.linalg.nullspace import DENSE_TOL, null_space
 from barhinge.pattern.crease import CreasePattern
 from barhinge.results import FoldPath
-from barhinge.solve.linear import SingularMatrixError, get_backend
 
 __all__ = ["RigidOptions", "rigid_fold", "RigidSolver"]
 

@@ -1,4 +1,5 @@
-"""Material and stiffness calibration of bars, bending hinges and fold hinges.
+"""Stiffness calibration of bars, bending hinges and fold hinges (the sheet's
+:class:`~barhinge.model.material.Material` in, stiffnesses out).
 
 Sources
 -------
@@ -26,14 +27,13 @@ Sources
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 
 import numpy as np
 from scipy.optimize import lsq_linear
 
-from barhinge import _check
 from barhinge.errors import ConfigError
+from barhinge.model.material import Material
 from barhinge.model.topology import Topology
 from barhinge.model.triangulate import Triangulation
 from barhinge.pattern.crease import CreasePattern
@@ -41,14 +41,13 @@ from barhinge.pattern.crease import CreasePattern
 logger = logging.getLogger(__name__)
 
 __all__ = [
-    "Material",
     "BEND_COEFFICIENT_F17",
     "DEFAULT_LSTAR_OVER_T",
     "bar_areas",
     "bend_stiffness",
     "bend_stiffness_kirchhoff",
     "face_areas",
-    "plate_bend_scale",
+    "face_frames",
     "fold_stiffness",
     "membrane_fit_matrices",
 ]
@@ -60,47 +59,6 @@ BEND_COEFFICIENT_F17 = 0.55
 MIN_AREA_FRACTION = 0.1
 #: default crease length scale L* / t when neither fold_stiffness nor L* is given.
 DEFAULT_LSTAR_OVER_T = 100.0
-
-
-@dataclasses.dataclass(frozen=True)
-class Material:
-    """Isotropic thin sheet.
-
-    Parameters
-    ----------
-    E : Young's modulus (force / length^2).
-    nu : Poisson's ratio, in [0, 0.5).
-    t : thickness (length).
-    """
-
-    E: float = 1.0e6
-    nu: float = 0.3
-    t: float = 0.01
-
-    def __post_init__(self) -> None:
-        # E > 0 and t > 0 finite; 0 <= nu < 0.5 (the membrane fit and the F17 bar areas
-        # assume a compressible, non-auxetic sheet; nu -> 0.5 makes bar areas vanish)
-        object.__setattr__(self, "E", _check.number(self.E, "material.E", 0.0, lo_open=True))
-        object.__setattr__(
-            self, "nu", _check.number(self.nu, "material.nu", 0.0, 0.5, hi_open=True)
-        )
-        object.__setattr__(self, "t", _check.number(self.t, "material.t", 0.0, lo_open=True))
-        if not np.isfinite(self.bending_rigidity) or self.bending_rigidity == 0.0:
-            raise ConfigError(
-                f"material.t = {self.t!r} with material.E = {self.E!r}: the bending rigidity "
-                "E t^3 / (12 (1 - nu^2)) is not a positive finite number"
-            )
-
-    @property
-    def bending_rigidity(self) -> float:
-        """Plate bending rigidity ``D = E t^3 / (12 (1 - nu^2))`` (force x length)."""
-        return self.E * self.t * self.t * self.t / (12.0 * (1.0 - self.nu * self.nu))
-
-    def membrane_mandel(self) -> np.ndarray:
-        """(3, 3) plane-stress stiffness in Mandel notation (shear entry ``E/(1+nu)``)."""
-        nu, E = self.nu, self.E
-        c = E / (1.0 - nu * nu)
-        return c * np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 1.0 - nu]])
 
 
 def fold_stiffness(
@@ -154,48 +112,6 @@ def bend_stiffness_kirchhoff(
     return 2.0 * material.bending_rigidity * (1.0 - material.nu) * A / DL**2
 
 
-def plate_bend_scale(
-    cp: CreasePattern, scheme: str, material: Material, faces: np.ndarray, refine: int = 4
-) -> np.ndarray:
-    """(len(faces),) factor for the ``"kirchhoff"`` bending stiffnesses of each face so that
-    the panel's corner-warping stiffness equals a Kirchhoff plate's (Morley elements,
-    :mod:`barhinge.model.continuum`): ``trace(S_plate) / trace(S_bar)`` of the stiffnesses
-    condensed to the corner deflections (exact for quadrilaterals, which have one warping
-    mode; a least-squares-like average for polygons). Faces of equal shape are computed
-    once."""
-    from barhinge.model.continuum import panel_corner_stiffness, plate_corner_stiffness
-    from barhinge.model.model import BarHingeModel
-
-    X = cp.vertices3d
-    faces = np.asarray(faces, dtype=np.int64)
-    out = np.ones(len(faces))
-    sizes = np.array([len(cp.faces[f]) for f in faces], dtype=np.int64)
-    for k in np.unique(sizes):
-        sel = np.flatnonzero(sizes == k)
-        F = np.array([cp.faces[f] for f in faces[sel]], dtype=np.int64)
-        e1, e2, _ = _face_frames(X, cp.faces, faces[sel])
-        P3 = X[F] - X[F[:, :1]]
-        Q = np.stack([np.einsum("nki,ni->nk", P3, e1), np.einsum("nki,ni->nk", P3, e2)], axis=2)
-        scale = np.abs(Q).max(axis=(1, 2))
-        key = np.round(Q.reshape(len(sel), -1) / scale[:, None], 9)
-        _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
-        vals = np.empty(len(first))
-        for u, f in enumerate(first):
-            Qf = Q[f]
-            panel = CreasePattern(
-                Qf, [[i, (i + 1) % k] for i in range(k)], ["B"] * k, faces=[list(range(k))]
-            )
-            m = BarHingeModel.from_pattern(
-                panel, scheme, material, bend_calibration="kirchhoff", fold_stiffness=0.0
-            )
-            Sb = panel_corner_stiffness(m, np.arange(k))
-            Sp = plate_corner_stiffness(Qf, material, refine)
-            vals[u] = float(np.trace(Sp) / np.trace(Sb)) if np.trace(Sb) > 0 else 1.0
-        out[sel] = vals[inv.ravel()]
-    logger.debug("plate bending calibration: %d faces", len(faces))
-    return out
-
-
 def face_areas(cp: CreasePattern, X: np.ndarray) -> np.ndarray:
     """(n_faces,) area of each face (Newell), in the geometry X (first nodes = vertices)."""
     out = np.zeros(cp.n_faces)
@@ -207,7 +123,7 @@ def face_areas(cp: CreasePattern, X: np.ndarray) -> np.ndarray:
     return out
 
 
-def _face_frames(X: np.ndarray, faces: tuple[tuple[int, ...], ...], fids: np.ndarray):
+def face_frames(X: np.ndarray, faces: tuple[tuple[int, ...], ...], fids: np.ndarray):
     """Newell normal, in-plane frame (e1, e2) and area of the faces ``fids``."""
     k = len(faces[fids[0]])
     F = np.array([faces[f] for f in fids], dtype=np.int64)
@@ -313,7 +229,7 @@ def bar_areas(
         m = int(per_face[fids[0]])
         idx = start[fids][:, None] + np.arange(m)[None, :]
         bar_ids = bf[idx, 0]  # (nf, m)
-        e1, e2, A = _face_frames(X, faces, fids)
+        e1, e2, A = face_frames(X, faces, fids)
         G = membrane_fit_matrices(X, topo.bars[bar_ids], e1, e2) * row_w[None, :, None]
         y = (A[:, None] * y_unit[None, :]) * row_w[None, :]
         sol = np.einsum("nmr,nr->nm", np.linalg.pinv(G), y)

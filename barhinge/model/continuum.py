@@ -19,7 +19,9 @@ kinematics:
 * :func:`panel_energy` -- the linear bar-and-hinge energy of a model with prescribed node
   displacements (the rest condensed out), for the same comparisons.
 
-Meshes are small (a few hundred elements) so the tests stay fast.
+Meshes are small (a few hundred elements) so the tests stay fast. Whole-panel comparisons
+(:func:`~barhinge.model.compare.panel_errors`) build models and live in
+:mod:`barhinge.model.compare`, above the model.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from barhinge.errors import ConfigError
-from barhinge.model.calibrate import Material
+from barhinge.model.material import Material
 
 __all__ = [
     "polygon_mesh",
@@ -37,8 +39,6 @@ __all__ = [
     "membrane_edge_load",
     "plate_corner_energy",
     "panel_energy",
-    "panel_errors",
-    "rectangle_edge_load_error",
     "homogeneous_energy",
     "strain_modes",
     "plate_corner_stiffness",
@@ -240,71 +240,6 @@ def homogeneous_energy(P: np.ndarray, material: Material, eps: np.ndarray) -> fl
     A = 0.5 * abs(np.sum(P[:, 0] * np.roll(P[:, 1], -1) - np.roll(P[:, 0], -1) * P[:, 1]))
     e = np.array([eps[0, 0], eps[1, 1], np.sqrt(2.0) * eps[0, 1]])
     return 0.5 * material.t * A * float(e @ material.membrane_mandel() @ e)
-
-
-def panel_errors(
-    P: np.ndarray,
-    material: Material,
-    scheme: str = "N5B8",
-    bar_calibration: str = "fit",
-    bend_calibration: str = "filipov",
-    plate_refine: int = 4,
-) -> dict[str, float]:
-    """Relative energy errors ``U_bar / U_continuum - 1`` of a single flat panel ``P`` (k, 2):
-    the three homogeneous membrane modes (corner displacements ``eps x``, other nodes free)
-    and, for k >= 4, the corner-warping energy for ``w = (x - xc)(y - yc)`` at the corners
-    (Morley reference)."""
-    from barhinge.model.model import BarHingeModel
-    from barhinge.pattern.crease import CreasePattern
-
-    P = np.asarray(P, float)
-    k = len(P)
-    cp = CreasePattern(P, [[i, (i + 1) % k] for i in range(k)], ["B"] * k, faces=[list(range(k))])
-    m = BarHingeModel.from_pattern(
-        cp, scheme, material, bar_calibration=bar_calibration, bend_calibration=bend_calibration
-    )
-    out: dict[str, float] = {}
-    for name, eps in strain_modes(material.nu).items():
-        pre = np.full((m.n_nodes, 3), np.nan)
-        pre[:, 2] = 0.0
-        pre[:k, :2] = P @ eps.T
-        out[name] = panel_energy(m, pre) / homogeneous_energy(P, material, eps) - 1.0
-    if k >= 4:
-        c = P.mean(axis=0)
-        w = (P[:, 0] - c[0]) * (P[:, 1] - c[1])
-        pre = np.full((m.n_nodes, 3), np.nan)
-        pre[:, :2] = 0.0
-        pre[:k, 2] = w
-        out["warp"] = panel_energy(m, pre) / plate_corner_energy(P, material, w, plate_refine) - 1
-    return out
-
-
-def rectangle_edge_load_error(
-    W: float,
-    H: float,
-    material: Material,
-    mode: str,
-    scheme: str = "N5B8",
-    bar_calibration: str = "fit",
-    refine: int = 3,
-) -> float:
-    """Relative error ``F_bar / F_continuum - 1`` of the force of :func:`membrane_edge_load`
-    (P2 membrane) for a W x H bar-and-hinge panel with the same supports (corners of the
-    clamped edge fixed, corners of the moved edge displaced by (1, 0), other nodes free)."""
-    from barhinge.model.model import BarHingeModel
-    from barhinge.pattern.crease import CreasePattern
-
-    P = np.array([[0, 0], [W, 0], [W, H], [0, H]], float)
-    cp = CreasePattern(P, [[0, 1], [1, 2], [2, 3], [3, 0]], ["B"] * 4, faces=[[0, 1, 2, 3]])
-    m = BarHingeModel.from_pattern(cp, scheme, material, bar_calibration=bar_calibration)
-    fixed, moved = ([0, 3], [1, 2]) if mode == "stretch" else ([0, 1], [2, 3])
-    pre = np.full((m.n_nodes, 3), np.nan)
-    pre[:, 2] = 0.0
-    pre[fixed, :2] = 0.0
-    pre[moved, 0] = 1.0
-    pre[moved, 1] = 0.0
-    F_bar = 2.0 * panel_energy(m, pre)
-    return F_bar / membrane_edge_load(W, H, material, mode, order=2, refine=refine) - 1.0
 
 
 def panel_energy(model, prescribed: np.ndarray) -> float:

@@ -10,6 +10,7 @@ quads and polygons.
 from __future__ import annotations
 
 import dataclasses
+import logging
 from functools import cached_property
 from typing import Any
 
@@ -30,21 +31,24 @@ from barhinge.kernels.geometry import (
 from barhinge.kernels.laws import bar_linear, hinge_linear, hinge_penetration
 from barhinge.model.calibrate import (
     BEND_COEFFICIENT_F17,
-    Material,
     bar_areas,
     bend_stiffness,
     bend_stiffness_kirchhoff,
     face_areas,
-    plate_bend_scale,
+    face_frames,
 )
 from barhinge.model.calibrate import (
     fold_stiffness as _fold_stiffness,
 )
+from barhinge.model.continuum import panel_corner_stiffness, plate_corner_stiffness
+from barhinge.model.material import Material
 from barhinge.model.topology import build_topology
 from barhinge.model.triangulate import triangulate
 from barhinge.pattern.crease import CreasePattern
 
-__all__ = ["BarHingeModel", "Evaluation", "FOLD_LAWS"]
+logger = logging.getLogger(__name__)
+
+__all__ = ["BarHingeModel", "Evaluation", "FOLD_LAWS", "plate_bend_scale"]
 
 FOLD_LAWS = ("linear", "penetration")
 
@@ -492,3 +496,42 @@ def _override(current: np.ndarray, value: Any, n: int, name: str) -> np.ndarray:
     if (v < 0).any():
         raise ConfigError(f"{name} has the entry {v[v < 0][0]}; expected numbers >= 0")
     return v.copy()
+
+
+def plate_bend_scale(
+    cp: CreasePattern, scheme: str, material: Material, faces: np.ndarray, refine: int = 4
+) -> np.ndarray:
+    """(len(faces),) factor for the ``"kirchhoff"`` bending stiffnesses of each face so that
+    the panel's corner-warping stiffness equals a Kirchhoff plate's (Morley elements,
+    :mod:`barhinge.model.continuum`): ``trace(S_plate) / trace(S_bar)`` of the stiffnesses
+    condensed to the corner deflections (exact for quadrilaterals, which have one warping
+    mode; a least-squares-like average for polygons). Faces of equal shape are computed
+    once."""
+    X = cp.vertices3d
+    faces = np.asarray(faces, dtype=np.int64)
+    out = np.ones(len(faces))
+    sizes = np.array([len(cp.faces[f]) for f in faces], dtype=np.int64)
+    for k in np.unique(sizes):
+        sel = np.flatnonzero(sizes == k)
+        F = np.array([cp.faces[f] for f in faces[sel]], dtype=np.int64)
+        e1, e2, _ = face_frames(X, cp.faces, faces[sel])
+        P3 = X[F] - X[F[:, :1]]
+        Q = np.stack([np.einsum("nki,ni->nk", P3, e1), np.einsum("nki,ni->nk", P3, e2)], axis=2)
+        scale = np.abs(Q).max(axis=(1, 2))
+        key = np.round(Q.reshape(len(sel), -1) / scale[:, None], 9)
+        _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
+        vals = np.empty(len(first))
+        for u, f in enumerate(first):
+            Qf = Q[f]
+            panel = CreasePattern(
+                Qf, [[i, (i + 1) % k] for i in range(k)], ["B"] * k, faces=[list(range(k))]
+            )
+            m = BarHingeModel.from_pattern(
+                panel, scheme, material, bend_calibration="kirchhoff", fold_stiffness=0.0
+            )
+            Sb = panel_corner_stiffness(m, np.arange(k))
+            Sp = plate_corner_stiffness(Qf, material, refine)
+            vals[u] = float(np.trace(Sp) / np.trace(Sb)) if np.trace(Sb) > 0 else 1.0
+        out[sel] = vals[inv.ravel()]
+    logger.debug("plate bending calibration: %d faces", len(faces))
+    return out

@@ -23,6 +23,8 @@ import numpy as np
 
 from barhinge._typing import ASSIGNMENTS
 from barhinge.errors import PatternError
+from barhinge.pattern.planar import planar_faces
+from barhinge.pattern.validate import check, merged_arrays
 
 __all__ = ["CreasePattern"]
 
@@ -130,13 +132,9 @@ class CreasePattern:
                 raise PatternError(f"edge {bad} has a non-finite fold angle {F[bad]}")
         faces = self.faces
         if merge_tol is not None:
-            from barhinge.pattern.validate import merged_arrays
-
             V, E, A, F, faces = merged_arrays(V, E, A, F, faces, merge_tol)
         faces_found = faces is None  # after the merge: faces of the merged graph
         if faces_found:
-            from barhinge.pattern.planar import planar_faces
-
             faces = planar_faces(V, E)
         try:
             faces_t = tuple(tuple(int(i) for i in f) for f in faces)
@@ -155,8 +153,6 @@ class CreasePattern:
         object.__setattr__(self, "meta", dict(self.meta))
         object.__setattr__(self, "_faces_found", faces_found)
         if validate:
-            from barhinge.pattern.validate import check
-
             check(self)
 
     # ------------------------------------------------------------------ sizes

@@ -19,20 +19,18 @@ coincident vertices and overlapping faces.
 from __future__ import annotations
 
 import dataclasses
-from typing import TYPE_CHECKING, Literal
+from typing import Any, Literal, Protocol, TypeVar
 
 import numpy as np
 
 from barhinge.errors import PatternError
 from barhinge.pattern.planar import pattern_plane
 
-if TYPE_CHECKING:
-    from barhinge.pattern.crease import CreasePattern
-
 __all__ = [
     "ANGLE_TOL_DEG",
     "REL_TOL",
     "Finding",
+    "PatternLike",
     "check",
     "findings",
     "holes",
@@ -49,6 +47,46 @@ ANGLE_TOL_DEG = 1e-3
 AREA_TOL = 1e-10
 
 Severity = Literal["error", "warning", "info"]
+
+
+class PatternLike(Protocol):
+    """What validation reads of a crease pattern.
+
+    :class:`~barhinge.pattern.crease.CreasePattern` checks itself on construction with
+    :func:`check`, so this module sits below it and names the attributes it needs here
+    instead of importing the class.
+    """
+
+    @property
+    def vertices(self) -> np.ndarray: ...
+    @property
+    def vertices3d(self) -> np.ndarray: ...
+    @property
+    def edges(self) -> np.ndarray: ...
+    @property
+    def assignment(self) -> np.ndarray: ...
+    @property
+    def fold_angles(self) -> np.ndarray: ...
+    @property
+    def faces(self) -> tuple[tuple[int, ...], ...]: ...
+    @property
+    def faces_found(self) -> bool: ...
+    @property
+    def edge_faces(self) -> np.ndarray: ...
+    @property
+    def developable(self) -> bool: ...
+    @property
+    def size(self) -> float: ...
+    @property
+    def n_vertices(self) -> int: ...
+    @property
+    def n_edges(self) -> int: ...
+    @property
+    def n_faces(self) -> int: ...
+    def replaced(self, **changes: Any) -> Any: ...
+
+
+_P = TypeVar("_P", bound=PatternLike)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -246,7 +284,7 @@ def _crossings(P: np.ndarray, E: np.ndarray, tol: float) -> list[Finding]:
     return out
 
 
-def holes(cp: CreasePattern) -> list[list[int]]:
+def holes(cp: PatternLike) -> list[list[int]]:
     """Boundary loops that are holes: per face-connected component, every boundary loop but
     the outer one (the one with the largest bounding box). Each loop is a list of edge ids."""
     from scipy.sparse import coo_matrix
@@ -289,7 +327,7 @@ def holes(cp: CreasePattern) -> list[list[int]]:
 class _Ctx:
     """Arrays shared by the checks of one pattern."""
 
-    cp: CreasePattern
+    cp: PatternLike
     tol: float
     cv: np.ndarray  # (K,) vertex of each face corner
     cf: np.ndarray  # (K,) face of each corner
@@ -638,7 +676,7 @@ def _sector_findings(c: _Ctx, developable: bool) -> list[Finding]:
     return out
 
 
-def findings(cp: CreasePattern, *, developable: bool | None = None) -> list[Finding]:
+def findings(cp: PatternLike, *, developable: bool | None = None) -> list[Finding]:
     """Every problem found in ``cp`` (errors first, then warnings and notes).
 
     Parameters
@@ -693,7 +731,7 @@ def _prev(nxt: np.ndarray) -> np.ndarray:
     return prv
 
 
-def check(cp: CreasePattern, *, developable: bool | None = None) -> None:
+def check(cp: PatternLike, *, developable: bool | None = None) -> None:
     """Raise :class:`PatternError` with a one-line message for the first error in ``cp``."""
     for f in findings(cp, developable=developable):
         if f.severity == "error":
@@ -768,9 +806,7 @@ def merged_arrays(V, E, A, F, faces, tol: float | None):
     return V2, E2[keep], A[keep], F[keep], faces2
 
 
-def merged(
-    cp: CreasePattern, tol: float | None = None, *, derive_faces: bool | None = None
-) -> CreasePattern:
+def merged(cp: _P, tol: float | None = None, *, derive_faces: bool | None = None) -> _P:
     """A repaired copy of ``cp``.
 
     Vertices closer than ``tol`` (default ``REL_TOL * size``) are merged and zero-length and

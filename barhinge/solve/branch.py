@@ -27,7 +27,8 @@ from typing import Any
 import numpy as np
 
 from barhinge.actuators import Actuators
-from barhinge.errors import BarhingeError
+from barhinge.errors import BarhingeError, ConvergenceError
+from barhinge.kinematics.path import RigidOptions, rigid_fold
 from barhinge.model.triangulate import triangulate
 
 __all__ = [
@@ -167,10 +168,6 @@ def rigid_guide(
     None when no rigid fold (with rigid or with triangulated panels) leaves the flat start;
     the reason is logged.
     """
-    # imported here: kinematics.path uses the solver's linear-algebra backends
-    from barhinge.errors import ConvergenceError
-    from barhinge.kinematics.path import RigidOptions, rigid_fold
-
     cp = model.pattern
     w, kb = fold_weights(model)
     opt = RigidOptions(check_rank=False)

@@ -22,7 +22,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from barhinge.errors import ConfigError
-from barhinge.solve.linear import SingularMatrixError
+from barhinge.linalg.backends import SingularMatrixError
 
 if TYPE_CHECKING:
     from barhinge.scene import Scene

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from barhinge.errors import ConfigError, ConvergenceError
+from barhinge.linalg.backends import SingularMatrixError, get_backend
 from barhinge.results import FoldPath, Interrupted
 from barhinge.solve.branch import RigidGuide, creases_against_assignment, is_flat, rigid_guide
 from barhinge.solve.controls import (
@@ -31,7 +32,6 @@ from barhinge.solve.controls import (
 )
 from barhinge.solve.diagnose import check as check_scene
 from barhinge.solve.diagnose import check_finite_tangent
-from barhinge.solve.linear import SingularMatrixError, get_backend
 
 if TYPE_CHECKING:
     from barhinge.scene import Scene

@@ -134,7 +134,7 @@ def test_actuators_determine_the_motion_and_can_be_steered():
     assert len(rep.actuators) == k
     rc = RigidConstraints.from_pattern(cp)
     rho = folded_sample(rc)
-    from barhinge.kinematics.linalg import null_space
+    from barhinge.linalg.nullspace import null_space
 
     N = null_space(rc.jacobian(rho)).basis
     for prefer in (None, "boundary", "interior", "spread"):
@@ -172,27 +172,6 @@ def test_suggested_actuators_drive_a_rigid_path():
     path = bh.rigid_fold(cp, acts.tolist(), (2 * targets).tolist(), steps=4)
     assert path.converged and path.meta["max_closure"] < 1e-10
     np.testing.assert_allclose(path.fold_angles_deg[-1, acts], 2 * targets, atol=1e-9)
-
-
-def test_sparse_rank_agrees_with_dense_svd():
-    """The sparse shift-invert method used above 600 creases gives the dense SVD's rank and
-    null space (flat Miura: first-order DOF 4n - 2 for n x n cells; folded: 1)."""
-    from barhinge.kinematics.linalg import null_space
-
-    n = 4
-    cp = bh.patterns.miura(n, n)
-    rc = RigidConstraints.from_pattern(cp)
-    for rho in (rc.rho0, folded_sample(rc)):
-        J = rc.jacobian(rho)
-        dense = null_space(J, dense_limit=10**6)
-        sparse = null_space(J, dense_limit=0)
-        assert dense.method == "svd" and sparse.method == "sparse-eigsh"
-        assert dense.rank == sparse.rank
-        # same subspace: projector difference
-        Pd = dense.basis @ dense.basis.T
-        Ps = sparse.basis @ sparse.basis.T
-        assert np.abs(Pd - Ps).max() < 1e-6
-    assert rc.n_var - null_space(rc.jacobian(rc.rho0)).rank == 4 * n - 2
 
 
 def test_pattern_with_a_hole_is_flagged():

@@ -9,7 +9,7 @@ import pytest
 import barhinge as bh
 from barhinge.errors import ConfigError
 from barhinge.kinematics.constraints import RigidConstraints
-from barhinge.solve.linear import available_backends
+from barhinge.linalg.backends import available_backends
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,7 @@ import barhinge as bh
 
 def test_compliant_solution_approaches_rigid_path():
     try:
-        from barhinge.model.calibrate import Material
+        from barhinge.model.material import Material
         from barhinge.model.model import BarHingeModel
     except ImportError:  # pragma: no cover - the model helper's work is absent
         pytest.skip("bar-and-hinge model not available")

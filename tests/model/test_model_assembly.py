@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 
 import barhinge as bh
 from barhinge.kernels.reference import assemble_reference
-from barhinge.model.calibrate import Material
+from barhinge.model.material import Material
 from barhinge.model.model import BarHingeModel
 from barhinge.pattern.crease import CreasePattern
 

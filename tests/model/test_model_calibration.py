@@ -7,16 +7,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from barhinge.model.calibrate import Material
+from barhinge.model.compare import panel_errors, rectangle_edge_load_error
 from barhinge.model.continuum import (
     homogeneous_energy,
     membrane_edge_load,
     membrane_energy,
-    panel_errors,
     plate_corner_energy,
-    rectangle_edge_load_error,
     strain_modes,
 )
+from barhinge.model.material import Material
 from barhinge.model.model import BarHingeModel
 from barhinge.pattern.crease import CreasePattern
 

@@ -10,7 +10,8 @@ from hypothesis import strategies as st
 import barhinge as bh
 from barhinge.errors import ConfigError, PatternError
 from barhinge.kernels.geometry import hinge_angle
-from barhinge.model.calibrate import Material, bend_stiffness
+from barhinge.model.calibrate import bend_stiffness
+from barhinge.model.material import Material
 from barhinge.model.model import BarHingeModel
 from barhinge.pattern.crease import CreasePattern
 

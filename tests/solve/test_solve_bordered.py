@@ -9,11 +9,11 @@ import pytest
 import scipy.sparse as sp
 
 import barhinge as bh
+from barhinge.linalg.backends import available_backends, get_backend
 from barhinge.model.model import BarHingeModel
 from barhinge.scene import Scene, miura_line_creases
 from barhinge.solve.controls import BorderedSystem, Timer, actuator_terms
-from barhinge.solve.linear import available_backends, get_backend
-from barhinge.solve.options import SolverOptions
+from barhinge.solver_options import SolverOptions
 
 
 def _miura_system(fold: float = 30.0, nudge: float = 0.0):

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 import barhinge as bh
-from barhinge.model.calibrate import Material
+from barhinge.model.material import Material
 from barhinge.model.model import BarHingeModel
 from barhinge.scene import Scene, miura_line_creases
 

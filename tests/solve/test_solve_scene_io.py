@@ -192,7 +192,7 @@ def test_cli_fold_writes_outputs(tmp_path):
     for name in ("fold_path.npz", "summary.json", "states.csv"):
         assert (out / name).is_file()
     assert bh.FoldPath.load(out / "fold_path.npz").n_states == 3
-    from barhinge.solve.linear import available_backends
+    from barhinge.linalg.backends import available_backends
 
     assert info["linear_solver"] == available_backends()[0]  # "auto": the fastest importable
     table = CliRunner().invoke(app, ["fold", str(_write_scene(tmp_path)), "--out", str(out)])

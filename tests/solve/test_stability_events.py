@@ -26,12 +26,12 @@ import scipy.sparse as sp
 
 import barhinge as bh
 from barhinge.errors import ConfigError, ConvergenceError
+from barhinge.linalg.backends import available_backends, get_backend
 from barhinge.model.model import BarHingeModel
 from barhinge.scene import Scene, miura_line_creases
 from barhinge.solve import newton
 from barhinge.solve.controls import BorderedSystem, Timer, actuator_terms
-from barhinge.solve.linear import available_backends, get_backend
-from barhinge.solve.options import SolverOptions
+from barhinge.solver_options import SolverOptions
 from barhinge.verify import von_mises_limit_load, von_mises_model
 
 H_VM = 0.3  # rise of barhinge.verify's von Mises truss

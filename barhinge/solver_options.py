@@ -1,4 +1,5 @@
-"""Solver options (tolerances, step control, linear backend)."""
+"""Solver options (tolerances, step control, linear backend): plain data that a
+:class:`~barhinge.scene.Scene` carries and :func:`barhinge.solve` reads, so it sits below both."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from barhinge.errors import ConfigError
 
 __all__ = ["SolverOptions"]
 
-#: linear solvers (see barhinge.solve.linear)
+#: linear solvers (see barhinge.linalg.backends)
 LINEAR_SOLVERS = ("auto", "superlu", "cholmod", "pardiso")
 #: upper bound of the iteration-count options (a typo such as 1e9 would never stop)
 MAX_ITERATIONS = 100_000
@@ -50,7 +51,7 @@ class SolverOptions:
     divergence_ratio : float
         Cut back when the residual grows by this factor over the increment's first residual.
     linear_solver : str
-        ``"auto"``, ``"superlu"``, ``"cholmod"`` or ``"pardiso"`` (see ``solve.linear``).
+        ``"auto"``, ``"superlu"``, ``"cholmod"`` or ``"pardiso"`` (see ``linalg.backends``).
     augmentation : float or "auto"
         Penalty ``p`` of the augmented-Lagrangian form ``K + p G^T G`` used to factorise the
         bordered actuator system (exact: the term is compensated on the right-hand side).

@@ -7,7 +7,7 @@ import pytest
 import scipy.sparse as sp
 
 from barhinge.errors import ConfigError
-from barhinge.solve.linear import SingularMatrixError, available_backends, get_backend
+from barhinge.linalg.backends import SingularMatrixError, available_backends, get_backend
 
 
 def _spd(n: int, seed: int) -> sp.csc_matrix:
