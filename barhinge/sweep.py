@@ -241,8 +241,7 @@ def load_study(path: str | Path) -> Study:
         raise ConfigError(f"study file {path}: [study] needs function = 'module:function'")
     if not isinstance(st["function"], str) or st["function"].count(":") != 1:
         raise ConfigError(
-            f"study file {path}: [study] function = {st['function']!r}; "
-            "expected 'module:function'"
+            f"study file {path}: [study] function = {st['function']!r}; expected 'module:function'"
         )
     if not all(isinstance(p, dict) for p in data.get("points", [])):
         raise ConfigError(f"study file {path}: every [[points]] entry must be a table")
@@ -428,20 +427,32 @@ def write_summary(out: str | Path, points: Sequence[Point], records: dict[str, R
         rows.append(row)
     cols = ["id", "status", *pcols, *rcols, "error_type", "error_message", "elapsed_s", "worker"]
     path = out / "summary.csv"
-    tmp = path.with_name(f".summary.{os.getpid()}.tmp")
+    tag = f"{os.getpid()}.{uuid.uuid4().hex[:8]}"
+    tmp = path.with_name(f".summary.{tag}.csv.tmp")
     with tmp.open("w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=cols, restval="")
         w.writeheader()
         w.writerows(rows)
-    os.replace(tmp, path)
+    tmpq = None
     with contextlib.suppress(ImportError):
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        tmpq = path.with_name(f".summary.{os.getpid()}.parquet.tmp")
+        tmpq = path.with_name(f".summary.{tag}.parquet.tmp")
         pq.write_table(pa.Table.from_pylist([{c: r.get(c) for c in cols} for r in rows]), tmpq)
+    # the two never disagree: the old parquet goes first, so a kill in between leaves the new
+    # csv alone (or both old ones)
+    (out / "summary.parquet").unlink(missing_ok=True)
+    os.replace(tmp, path)
+    if tmpq is not None:
         os.replace(tmpq, out / "summary.parquet")
     return path
+
+
+def _remove_summary(out: Path) -> None:
+    """Remove the summary files of ``out`` (they describe another study)."""
+    for name in ("summary.parquet", "summary.csv"):
+        (out / name).unlink(missing_ok=True)
 
 
 # ------------------------------------------------------------------------------ driver
@@ -613,10 +624,16 @@ def run_study(
     t0 = time.perf_counter()
     pdir = _points_dir(out)
     pdir.mkdir(parents=True, exist_ok=True)
-    for stale in pdir.glob(".*.tmp"):
+    for stale in [*pdir.glob(".*.tmp"), *out.glob(".*.tmp")]:  # of a killed run
         stale.unlink(missing_ok=True)
-    spec = dataclasses.asdict(study) | {"out": str(out)}
-    _atomic_write(out / "study.json", _dumps(spec, indent=1))
+    spec = _dumps(dataclasses.asdict(study) | {"out": str(out)}, indent=1)
+    try:
+        same = (out / "study.json").read_text() == spec
+    except (OSError, UnicodeDecodeError):
+        same = False
+    if not same:  # the summary of another study must not sit beside this study.json
+        _remove_summary(out)
+        _atomic_write(out / "study.json", spec)
 
     points = study.expand()
     known = read_records(out)
@@ -634,6 +651,8 @@ def run_study(
         out=out, total=len(points), skipped=len(points) - len(todo), pending=len(todo)
     )
     rep.records = records
+    if not same or not (out / "summary.csv").exists():
+        write_summary(out, points, records)  # at once: what is known of this study
     if on_start:
         on_start(rep)
     log.info("study %s: %d points, %d to run (%s)", study.name, len(points), len(todo), mode)
