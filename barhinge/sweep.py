@@ -124,6 +124,41 @@ def _check_finite(v: Any, where: str) -> None:
         )
 
 
+_JSON_SCALARS = (str, int, float, bool, type(None))
+
+
+def _not_json(v: Any, where: str) -> str | None:
+    """``"<where> = <value> (<type>)"`` for the first value of ``v`` that has no JSON form
+    (a TOML date or time, a set, an object), else None."""
+    if isinstance(v, dict):
+        for k, x in v.items():
+            if not isinstance(k, str):
+                return f"{where} key {k!r} ({type(k).__name__})"
+            bad = _not_json(x, f"{where}.{k}" if where else k)
+            if bad:
+                return bad
+        return None
+    if isinstance(v, list | tuple):
+        for i, x in enumerate(v):
+            bad = _not_json(x, f"{where}[{i}]")
+            if bad:
+                return bad
+        return None
+    if isinstance(v, _JSON_SCALARS) or hasattr(v, "tolist") or isinstance(v, Path):
+        return None
+    return f"{where} = {v!r} ({type(v).__name__})"
+
+
+def _check_json(v: Any, where: str) -> None:
+    """ConfigError naming the first study parameter without a JSON form."""
+    bad = _not_json(v, "")
+    if bad:
+        raise ConfigError(
+            f"study {where} {bad.lstrip('.')}; expected numbers, text, true/false, lists or "
+            "tables (dates and times are not parameters: write them as text)"
+        )
+
+
 def point_id(params: dict[str, Any]) -> str:
     """Stable identity of a parameter point: 16 hex digits of SHA-256 of its canonical JSON.
 
@@ -179,12 +214,22 @@ class Study:
         for k, v in self.grid.items():
             if not isinstance(v, list) or not v:
                 raise ConfigError(f"grid entry {k!r} must be a non-empty list, got {v!r}")
-        if not isinstance(self.batch_size, int) or self.batch_size < 1:
+        if (
+            isinstance(self.batch_size, bool)
+            or not isinstance(self.batch_size, int)
+            or self.batch_size < 1
+        ):
             raise ConfigError(f"batch_size must be an integer >= 1, got {self.batch_size!r}")
-        _check_finite(self.grid, "[grid]")
-        _check_finite(self.fixed, "[fixed]")
         for i, p in enumerate(self.points):
-            _check_finite(p, f"[[points]] {i}:")
+            if not isinstance(p, dict):
+                raise ConfigError(f"study [[points]] {i}: {p!r}; expected a table")
+        for value, where in (
+            (self.grid, "[grid]"),
+            (self.fixed, "[fixed]"),
+            *((p, f"[[points]] {i}:") for i, p in enumerate(self.points)),
+        ):
+            _check_json(value, where)
+            _check_finite(value, where)
 
     def expand(self) -> list[Point]:
         """All points: the grid product then the explicit points; repeats dropped."""
