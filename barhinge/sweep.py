@@ -611,6 +611,61 @@ def _dask(
             yield recs
 
 
+def _check_signature(study: Study, points: Sequence[Point], *, required: bool) -> None:
+    """ConfigError when the point function cannot take some point's parameters: a key
+    it does not accept (a typo in ``[grid]``) or a required parameter no point gives. Checked
+    before anything runs, so a wrong key stops the study instead of failing every point.
+    Where the function cannot be imported here (``required=False``: a cluster whose workers
+    see other folders) the check is skipped and the workers report it per point."""
+    import inspect
+
+    try:
+        fn = _resolve(study.function, study.paths)
+    except ConfigError:
+        if required:
+            raise
+        log.info("cannot import %s here; its parameters are checked on the workers", study.function)
+        return
+    try:
+        sig = inspect.signature(fn)
+    except (TypeError, ValueError):  # a builtin or a C function: nothing to read
+        return
+    params = sig.parameters.values()
+    if any(p.kind is p.VAR_KEYWORD for p in params):
+        accepted = None
+    else:
+        accepted = {p.name for p in params if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
+    needed = [
+        p.name
+        for p in params
+        if p.default is p.empty and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
+    ]
+    takes = ", ".join(p.name for p in params) or "no parameters"
+    for pt in points:
+        extra = [k for k in pt.params if accepted is not None and k not in accepted]
+        if extra:
+            where = _where(study, extra[0])
+            raise ConfigError(
+                f"study {where} key {extra[0]!r}: the point function {study.function} does "
+                f"not accept it; it takes {takes}"
+            )
+        missing = [k for k in needed if k not in pt.params]
+        if missing:
+            raise ConfigError(
+                f"study point {pt.params}: the point function {study.function} needs "
+                f"{missing[0]!r}, which no [grid], [fixed] or [[points]] entry gives"
+            )
+
+
+def _where(study: Study, key: str) -> str:
+    """The table of a study that sets ``key``."""
+    if key in study.grid:
+        return "[grid]"
+    if key in study.fixed:
+        return "[fixed]"
+    return "[[points]]"
+
+
 def run_study(
     study: Study,
     *,
@@ -667,6 +722,8 @@ def run_study(
     if out is None:
         raise ConfigError("no output folder: give out= or set [study] out")
     t0 = time.perf_counter()
+    points = study.expand()
+    _check_signature(study, points, required=mode == "serial")
     pdir = _points_dir(out)
     pdir.mkdir(parents=True, exist_ok=True)
     for stale in [*pdir.glob(".*.tmp"), *out.glob(".*.tmp")]:  # of a killed run
@@ -680,7 +737,6 @@ def run_study(
         _remove_summary(out)
         _atomic_write(out / "study.json", spec)
 
-    points = study.expand()
     known = read_records(out)
     mine = {p.id for p in points}
     stray = len(set(known) - mine)

@@ -24,7 +24,7 @@ from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
-__all__ = ["CASES", "Case", "Check", "Quantity", "run", "summary"]
+__all__ = ["CASES", "Case", "Check", "Quantity", "run", "select", "summary"]
 
 log = logging.getLogger(__name__)
 
@@ -141,6 +141,31 @@ def run_case(case: Case) -> list[Check]:
     return rows
 
 
+def select(
+    cases: Iterable[Case] | None = None,
+    *,
+    names: Sequence[str] | None = None,
+    quick: bool = False,
+) -> list[Case]:
+    """The cases :func:`run` runs: ``names`` (in that order; unknown names raise
+    ConfigError), else the ``quick`` ones if asked, else all of ``cases`` (default
+    :data:`CASES`)."""
+    from barhinge.errors import ConfigError
+
+    pool = list(CASES.values()) if cases is None else list(cases)
+    if names:
+        known = {c.name: c for c in pool}
+        bad = [n for n in names if n not in known]
+        if bad:
+            raise ConfigError(
+                f"unknown verify case {bad[0]!r}; expected one of {', '.join(sorted(known))}"
+            )
+        return [known[n] for n in names]
+    if quick:
+        return [c for c in pool if c.quick]
+    return pool
+
+
 def run(
     cases: Iterable[Case] | None = None,
     *,
@@ -161,21 +186,8 @@ def run(
     on_case : callable, optional
         Called after each case with its rows (progress display).
     """
-    from barhinge.errors import ConfigError
-
-    pool = list(CASES.values()) if cases is None else list(cases)
-    if names:
-        known = {c.name: c for c in pool}
-        bad = [n for n in names if n not in known]
-        if bad:
-            raise ConfigError(
-                f"unknown verify case {bad[0]!r}; expected one of {', '.join(sorted(known))}"
-            )
-        pool = [known[n] for n in names]
-    elif quick:
-        pool = [c for c in pool if c.quick]
     out: list[Check] = []
-    for case in pool:
+    for case in select(cases, names=names, quick=quick):
         rows = run_case(case)
         out.extend(rows)
         if on_case is not None:
