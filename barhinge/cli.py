@@ -3,7 +3,8 @@
 The CLI owns the terminal: rich tables and progress bars. :func:`main` is its one error
 boundary: usage mistakes, library errors and unreadable/unwritable files become one line on
 stderr and exit code 2 (bad input) or 3 (did not converge); anything else is a bug (exit 70);
-``--debug`` shows the traceback.
+``--debug`` shows the traceback. Ctrl-C exits with 130, SIGTERM with 143 (``fold`` and
+``study`` write what finished first).
 """
 
 from __future__ import annotations
