@@ -3,13 +3,18 @@
 The CLI owns the terminal: rich tables and progress bars. :func:`main` is its one error
 boundary: usage mistakes, library errors and unreadable/unwritable files become one line on
 stderr and exit code 2 (bad input) or 3 (did not converge); anything else is a bug (exit 70);
-``--debug`` shows the traceback.
+``--debug`` shows the traceback. Ctrl-C exits with 130, SIGTERM with 143 (``fold`` and
+``study`` write what finished first).
 """
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
 import json
+import signal
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Annotated
 
@@ -28,6 +33,42 @@ app = typer.Typer(
 console = Console()
 err_console = Console(stderr=True)
 _state = {"debug": False}
+
+
+#: exit code of a run stopped by SIGTERM (128 + 15, the shell's convention)
+EXIT_TERMINATED = 143
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the signal arrives so that it unwinds like Ctrl-C."""
+
+
+@contextlib.contextmanager
+def _sigterm_as_interrupt() -> Iterator[None]:
+    """Within the block SIGTERM raises :class:`_Terminated` (a KeyboardInterrupt), so a
+    ``kill PID`` writes partial results as Ctrl-C does; the previous handler is restored."""
+
+    def on_term(signum: int, frame: object) -> None:
+        raise _Terminated
+
+    try:
+        old = signal.signal(signal.SIGTERM, on_term)
+    except ValueError:  # not the main thread (an embedding application): leave it alone
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, old)
+
+
+def _terminated(exc: BaseException) -> bool:
+    """Whether ``exc`` (or what it was raised from) is a SIGTERM."""
+    while exc is not None:
+        if isinstance(exc, _Terminated):
+            return True
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 @app.callback()
@@ -320,13 +361,20 @@ def _dof_pattern(spec: str):
     return gen(**kw)
 
 
+#: picture formats of ``barhinge dof --png`` (matplotlib picks the format from the suffix)
+_PICTURE_SUFFIXES = (".png", ".svg", ".pdf")
+
+
 @app.command()
 def dof(
     pattern: Annotated[
         str, typer.Argument(help="Pattern file (.fold/.svg) or family spec, e.g. miura:nx=4,ny=4")
     ],
     as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
-    png: Annotated[Path | None, typer.Option("--png", help="Write the local-DOF picture.")] = None,
+    png: Annotated[
+        Path | None,
+        typer.Option("--png", help="Write the local-DOF picture (.png, .svg or .pdf)."),
+    ] = None,
     triangulated: Annotated[
         bool, typer.Option("--triangulated", help="Let panels fold along diagonals.")
     ] = False,
@@ -338,6 +386,13 @@ def dof(
     """Rigid-origami DOF: global (count and rank), redundancy, local DOF and actuators."""
     from barhinge.kinematics.dof import dof as compute_dof
 
+    if png is not None and png.suffix.lower() not in _PICTURE_SUFFIXES:
+        from barhinge.errors import ConfigError
+
+        raise ConfigError(
+            f"--png {png}: expected a picture file ending in "
+            f"{', '.join(_PICTURE_SUFFIXES[:-1])} or {_PICTURE_SUFFIXES[-1]}"
+        )
     cp = _dof_pattern(pattern)
     rep = compute_dof(cp, triangulated=triangulated, prefer=prefer)
     if png is not None:
@@ -513,6 +568,8 @@ def fold_cmd(
         console=err_console,
         disable=as_json,
     )
+    term = contextlib.ExitStack()  # SIGTERM (kill PID) stops the run as Ctrl-C does
+    term.enter_context(_sigterm_as_interrupt())
     try:
         with bar:
             task = bar.add_task("fold", total=scene.steps)
@@ -521,6 +578,10 @@ def fold_cmd(
             except (ConvergenceError, Interrupted) as exc:
                 part = exc.last_state
                 if part is not None:
+                    if _terminated(exc):  # the solver saw a KeyboardInterrupt: say which
+                        part = dataclasses.replace(
+                            part, message=part.message.replace("(Ctrl-C)", "(SIGTERM)")
+                        )
                     write_outputs(part, scene, out, overwrite=overwrite)
                     _print_events(part, err_console)
                     err_console.print(f"partial results ({part.n_states} states) in {out}",
@@ -528,13 +589,19 @@ def fold_cmd(
                 raise
         files = write_outputs(path, scene, out, overwrite=overwrite)
     except Interrupted as exc:
+        stop = _terminated(exc)
         part = exc.last_state
         msg = part.message if part is not None else "interrupted (Ctrl-C) before state 0"
+        if stop:
+            msg = msg.replace("(Ctrl-C)", "(SIGTERM)")
         err_console.print(msg, highlight=False, markup=False)
-        sys.exit(130)
-    except KeyboardInterrupt:
-        err_console.print(f"interrupted; {out} unchanged", highlight=False, markup=False)
-        sys.exit(130)
+        sys.exit(EXIT_TERMINATED if stop else 130)
+    except KeyboardInterrupt as exc:
+        what = "terminated (SIGTERM)" if _terminated(exc) else "interrupted"
+        err_console.print(f"{what}; {out} unchanged", highlight=False, markup=False)
+        sys.exit(EXIT_TERMINATED if _terminated(exc) else 130)
+    finally:
+        term.close()
     info = summary(path, scene)
     from barhinge.plot import results_rows, results_summary
 
@@ -784,7 +851,7 @@ def study(
         progress.update(task, completed=rep.finished, done=rep.done, failed=rep.failed)
 
     try:
-        with progress:
+        with _sigterm_as_interrupt(), progress:
             rep = run_study(
                 spec,
                 out=out,
@@ -796,9 +863,10 @@ def study(
                 on_start=on_start,
                 on_record=on_record,
             )
-    except KeyboardInterrupt:
-        err_console.print("interrupted; finished points are saved, rerun to resume")
-        sys.exit(130)
+    except KeyboardInterrupt as exc:
+        what = "terminated (SIGTERM)" if _terminated(exc) else "interrupted"
+        err_console.print(f"{what}; finished points are saved, rerun to resume")
+        sys.exit(EXIT_TERMINATED if _terminated(exc) else 130)
     counts = {
         "out": str(rep.out),
         "total": rep.total,
@@ -836,7 +904,7 @@ def verify_cmd(
 
     from barhinge import verify
 
-    if list_cases:
+    if list_cases:  # the cases --case and --quick select, as a run would
         data = {
             c.name: {
                 "citation": c.citation,
@@ -844,7 +912,7 @@ def verify_cmd(
                 "quantities": [q.name for q in c.quantities],
                 "quick": c.quick,
             }
-            for c in verify.CASES.values()
+            for c in verify.select(names=case or None, quick=quick)
         }
         if as_json:
             print_json(data)
@@ -938,8 +1006,29 @@ def _is_usage_error(exc: BaseException) -> bool:
     )
 
 
-def _usage_text(exc: BaseException) -> str:
+def _option_values(param: object, argv: list[str]) -> list[str]:
+    """The words ``argv`` gives option ``param`` (``--step abc`` or ``--step=abc``)."""
+    names = [*getattr(param, "opts", []), *getattr(param, "secondary_opts", [])]
+    if not names or getattr(param, "is_flag", False):
+        return []
+    found = []
+    for i, word in enumerate(argv):
+        if word == "--":
+            break
+        if word in names and i + 1 < len(argv):
+            found.append(argv[i + 1])
+        for n in names:
+            if n.startswith("--") and word.startswith(n + "="):
+                found.append(word[len(n) + 1 :])
+    return found
+
+
+def _usage_text(exc: BaseException, argv: list[str] | None = None) -> str:
     msg = _one_line(exc.format_message())  # type: ignore[attr-defined]
+    if msg.startswith("Invalid value for") and argv:  # name the value given, not only the option
+        values = [v for v in _option_values(getattr(exc, "param", None), argv) if v not in msg]
+        if values:
+            msg += f" (got {', '.join(repr(v) for v in dict.fromkeys(values))})"
     ctx = getattr(exc, "ctx", None)
     path = getattr(ctx, "command_path", None)
     return f"{msg} (see '{path} --help')" if path else msg
@@ -965,13 +1054,14 @@ def main(argv: list[str] | None = None) -> None:
     anything else, which is a bug. ``--debug`` re-raises, showing the traceback.
     """
     _state["debug"] = False  # set by the --debug callback; reset for in-process calls
+    words = list(sys.argv[1:] if argv is None else argv)
     try:
         code = app(args=argv, prog_name="barhinge", standalone_mode=False)
     except SystemExit:  # typer.Exit / sys.exit inside a command: its code stands
         raise
-    except KeyboardInterrupt:
-        _say("interrupted")
-        sys.exit(130)
+    except KeyboardInterrupt as exc:
+        _say("terminated (SIGTERM)" if _terminated(exc) else "interrupted")
+        sys.exit(EXIT_TERMINATED if _terminated(exc) else 130)
     except BarhingeError as exc:
         if _state["debug"]:
             raise
@@ -989,7 +1079,7 @@ def main(argv: list[str] | None = None) -> None:
                 sys.stdout.write(text.rstrip("\n") + "\n")
             sys.exit(EXIT_BAD_INPUT)
         if _is_usage_error(exc):
-            _say(f"error: {_usage_text(exc)}")
+            _say(f"error: {_usage_text(exc, words)}")
             sys.exit(EXIT_BAD_INPUT)
         if type(exc).__name__ == "Abort":  # click's or typer's (EOF at a prompt)
             _say("aborted")

@@ -124,6 +124,41 @@ def _check_finite(v: Any, where: str) -> None:
         )
 
 
+_JSON_SCALARS = (str, int, float, bool, type(None))
+
+
+def _not_json(v: Any, where: str) -> str | None:
+    """``"<where> = <value> (<type>)"`` for the first value of ``v`` that has no JSON form
+    (a TOML date or time, a set, an object), else None."""
+    if isinstance(v, dict):
+        for k, x in v.items():
+            if not isinstance(k, str):
+                return f"{where} key {k!r} ({type(k).__name__})"
+            bad = _not_json(x, f"{where}.{k}" if where else k)
+            if bad:
+                return bad
+        return None
+    if isinstance(v, list | tuple):
+        for i, x in enumerate(v):
+            bad = _not_json(x, f"{where}[{i}]")
+            if bad:
+                return bad
+        return None
+    if isinstance(v, _JSON_SCALARS) or hasattr(v, "tolist") or isinstance(v, Path):
+        return None
+    return f"{where} = {v!r} ({type(v).__name__})"
+
+
+def _check_json(v: Any, where: str) -> None:
+    """ConfigError naming the first study parameter without a JSON form."""
+    bad = _not_json(v, "")
+    if bad:
+        raise ConfigError(
+            f"study {where} {bad.lstrip('.')}; expected numbers, text, true/false, lists or "
+            "tables (dates and times are not parameters: write them as text)"
+        )
+
+
 def point_id(params: dict[str, Any]) -> str:
     """Stable identity of a parameter point: 16 hex digits of SHA-256 of its canonical JSON.
 
@@ -179,12 +214,22 @@ class Study:
         for k, v in self.grid.items():
             if not isinstance(v, list) or not v:
                 raise ConfigError(f"grid entry {k!r} must be a non-empty list, got {v!r}")
-        if not isinstance(self.batch_size, int) or self.batch_size < 1:
+        if (
+            isinstance(self.batch_size, bool)
+            or not isinstance(self.batch_size, int)
+            or self.batch_size < 1
+        ):
             raise ConfigError(f"batch_size must be an integer >= 1, got {self.batch_size!r}")
-        _check_finite(self.grid, "[grid]")
-        _check_finite(self.fixed, "[fixed]")
         for i, p in enumerate(self.points):
-            _check_finite(p, f"[[points]] {i}:")
+            if not isinstance(p, dict):
+                raise ConfigError(f"study [[points]] {i}: {p!r}; expected a table")
+        for value, where in (
+            (self.grid, "[grid]"),
+            (self.fixed, "[fixed]"),
+            *((p, f"[[points]] {i}:") for i, p in enumerate(self.points)),
+        ):
+            _check_json(value, where)
+            _check_finite(value, where)
 
     def expand(self) -> list[Point]:
         """All points: the grid product then the explicit points; repeats dropped."""
@@ -241,8 +286,7 @@ def load_study(path: str | Path) -> Study:
         raise ConfigError(f"study file {path}: [study] needs function = 'module:function'")
     if not isinstance(st["function"], str) or st["function"].count(":") != 1:
         raise ConfigError(
-            f"study file {path}: [study] function = {st['function']!r}; "
-            "expected 'module:function'"
+            f"study file {path}: [study] function = {st['function']!r}; expected 'module:function'"
         )
     if not all(isinstance(p, dict) for p in data.get("points", [])):
         raise ConfigError(f"study file {path}: every [[points]] entry must be a table")
@@ -428,20 +472,32 @@ def write_summary(out: str | Path, points: Sequence[Point], records: dict[str, R
         rows.append(row)
     cols = ["id", "status", *pcols, *rcols, "error_type", "error_message", "elapsed_s", "worker"]
     path = out / "summary.csv"
-    tmp = path.with_name(f".summary.{os.getpid()}.tmp")
+    tag = f"{os.getpid()}.{uuid.uuid4().hex[:8]}"
+    tmp = path.with_name(f".summary.{tag}.csv.tmp")
     with tmp.open("w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=cols, restval="")
         w.writeheader()
         w.writerows(rows)
-    os.replace(tmp, path)
+    tmpq = None
     with contextlib.suppress(ImportError):
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        tmpq = path.with_name(f".summary.{os.getpid()}.parquet.tmp")
+        tmpq = path.with_name(f".summary.{tag}.parquet.tmp")
         pq.write_table(pa.Table.from_pylist([{c: r.get(c) for c in cols} for r in rows]), tmpq)
+    # the two never disagree: the old parquet goes first, so a kill in between leaves the new
+    # csv alone (or both old ones)
+    (out / "summary.parquet").unlink(missing_ok=True)
+    os.replace(tmp, path)
+    if tmpq is not None:
         os.replace(tmpq, out / "summary.parquet")
     return path
+
+
+def _remove_summary(out: Path) -> None:
+    """Remove the summary files of ``out`` (they describe another study)."""
+    for name in ("summary.parquet", "summary.csv"):
+        (out / name).unlink(missing_ok=True)
 
 
 # ------------------------------------------------------------------------------ driver
@@ -555,6 +611,61 @@ def _dask(
             yield recs
 
 
+def _check_signature(study: Study, points: Sequence[Point], *, required: bool) -> None:
+    """ConfigError when the point function cannot take some point's parameters: a key
+    it does not accept (a typo in ``[grid]``) or a required parameter no point gives. Checked
+    before anything runs, so a wrong key stops the study instead of failing every point.
+    Where the function cannot be imported here (``required=False``: a cluster whose workers
+    see other folders) the check is skipped and the workers report it per point."""
+    import inspect
+
+    try:
+        fn = _resolve(study.function, study.paths)
+    except ConfigError:
+        if required:
+            raise
+        log.info("cannot import %s here; its parameters are checked on the workers", study.function)
+        return
+    try:
+        sig = inspect.signature(fn)
+    except (TypeError, ValueError):  # a builtin or a C function: nothing to read
+        return
+    params = sig.parameters.values()
+    if any(p.kind is p.VAR_KEYWORD for p in params):
+        accepted = None
+    else:
+        accepted = {p.name for p in params if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
+    needed = [
+        p.name
+        for p in params
+        if p.default is p.empty and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
+    ]
+    takes = ", ".join(p.name for p in params) or "no parameters"
+    for pt in points:
+        extra = [k for k in pt.params if accepted is not None and k not in accepted]
+        if extra:
+            where = _where(study, extra[0])
+            raise ConfigError(
+                f"study {where} key {extra[0]!r}: the point function {study.function} does "
+                f"not accept it; it takes {takes}"
+            )
+        missing = [k for k in needed if k not in pt.params]
+        if missing:
+            raise ConfigError(
+                f"study point {pt.params}: the point function {study.function} needs "
+                f"{missing[0]!r}, which no [grid], [fixed] or [[points]] entry gives"
+            )
+
+
+def _where(study: Study, key: str) -> str:
+    """The table of a study that sets ``key``."""
+    if key in study.grid:
+        return "[grid]"
+    if key in study.fixed:
+        return "[fixed]"
+    return "[[points]]"
+
+
 def run_study(
     study: Study,
     *,
@@ -611,14 +722,21 @@ def run_study(
     if out is None:
         raise ConfigError("no output folder: give out= or set [study] out")
     t0 = time.perf_counter()
+    points = study.expand()
+    _check_signature(study, points, required=mode == "serial")
     pdir = _points_dir(out)
     pdir.mkdir(parents=True, exist_ok=True)
-    for stale in pdir.glob(".*.tmp"):
+    for stale in [*pdir.glob(".*.tmp"), *out.glob(".*.tmp")]:  # of a killed run
         stale.unlink(missing_ok=True)
-    spec = dataclasses.asdict(study) | {"out": str(out)}
-    _atomic_write(out / "study.json", _dumps(spec, indent=1))
+    spec = _dumps(dataclasses.asdict(study) | {"out": str(out)}, indent=1)
+    try:
+        same = (out / "study.json").read_text() == spec
+    except (OSError, UnicodeDecodeError):
+        same = False
+    if not same:  # the summary of another study must not sit beside this study.json
+        _remove_summary(out)
+        _atomic_write(out / "study.json", spec)
 
-    points = study.expand()
     known = read_records(out)
     mine = {p.id for p in points}
     stray = len(set(known) - mine)
@@ -634,6 +752,8 @@ def run_study(
         out=out, total=len(points), skipped=len(points) - len(todo), pending=len(todo)
     )
     rep.records = records
+    if not same or not (out / "summary.csv").exists():
+        write_summary(out, points, records)  # at once: what is known of this study
     if on_start:
         on_start(rep)
     log.info("study %s: %d points, %d to run (%s)", study.name, len(points), len(todo), mode)

@@ -40,7 +40,7 @@ from barhinge.patterns.properties import maekawa_count
 from barhinge.scene import Scene
 from barhinge.solve.newton import solve
 
-__all__ = ["CASES", "Case", "Check", "Quantity", "run", "summary"]
+__all__ = ["CASES", "Case", "Check", "Quantity", "run", "select", "summary"]
 
 log = logging.getLogger(__name__)
 
@@ -157,6 +157,29 @@ def run_case(case: Case) -> list[Check]:
     return rows
 
 
+def select(
+    cases: Iterable[Case] | None = None,
+    *,
+    names: Sequence[str] | None = None,
+    quick: bool = False,
+) -> list[Case]:
+    """The cases :func:`run` runs: ``names`` (in that order; unknown names raise
+    ConfigError), else the ``quick`` ones if asked, else all of ``cases`` (default
+    :data:`CASES`)."""
+    pool = list(CASES.values()) if cases is None else list(cases)
+    if names:
+        known = {c.name: c for c in pool}
+        bad = [n for n in names if n not in known]
+        if bad:
+            raise ConfigError(
+                f"unknown verify case {bad[0]!r}; expected one of {', '.join(sorted(known))}"
+            )
+        return [known[n] for n in names]
+    if quick:
+        return [c for c in pool if c.quick]
+    return pool
+
+
 def run(
     cases: Iterable[Case] | None = None,
     *,
@@ -177,20 +200,8 @@ def run(
     on_case : callable, optional
         Called after each case with its rows (progress display).
     """
-
-    pool = list(CASES.values()) if cases is None else list(cases)
-    if names:
-        known = {c.name: c for c in pool}
-        bad = [n for n in names if n not in known]
-        if bad:
-            raise ConfigError(
-                f"unknown verify case {bad[0]!r}; expected one of {', '.join(sorted(known))}"
-            )
-        pool = [known[n] for n in names]
-    elif quick:
-        pool = [c for c in pool if c.quick]
     out: list[Check] = []
-    for case in pool:
+    for case in select(cases, names=names, quick=quick):
         rows = run_case(case)
         out.extend(rows)
         if on_case is not None:

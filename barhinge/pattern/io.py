@@ -38,6 +38,8 @@ def read(path: str | Path, **kwargs: Any) -> CreasePattern:
             f"{path.name}: unknown crease-pattern file type {path.suffix!r}; expected "
             f"{' or '.join(READERS)}"
         ) from None
+    if path.is_dir():
+        raise PatternError(f"{path}: is a folder, not a crease-pattern file")
     if not path.is_file():
         raise PatternError(f"{path}: no such file")
     return getattr(importlib.import_module(module), name)(path, **kwargs)

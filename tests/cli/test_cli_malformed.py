@@ -527,6 +527,10 @@ STUDIES: dict[str, str] = {
     "batch_size_zero": _study('function = "points:point"\npaths = ["."]\nbatch_size = 0\n'),
     "paths_number": _study('function = "points:point"\npaths = 3\n'),
     "study_number": "study = 3\n",
+    # keys the point function does not take: every point would fail; stopped before running
+    "grid_key_not_a_parameter": _study(rest="[grid]\nx = [1, 2]\nbogus = [1]\n"),
+    "fixed_key_not_a_parameter": _study(rest="[fixed]\nsteps = 3\n"),
+    "grid_date": _study(rest="[grid]\nx = [2020-01-02]\n"),
 }
 
 _STUDY_NEEDLE = {
@@ -546,6 +550,9 @@ _STUDY_NEEDLE = {
     "batch_size_zero": "batch_size",
     "paths_number": "paths",
     "study_number": "study",
+    "grid_key_not_a_parameter": "[grid] key 'bogus'",
+    "fixed_key_not_a_parameter": "[fixed] key 'steps'",
+    "grid_date": "x[0] = datetime.date",
 }
 
 
@@ -602,22 +609,30 @@ def _rows() -> list[Row]:
         add(Row(f"no-value-{argv.split()[0]}-{argv.split()[-1]}", argv, needle))
     # bad option values
     for argv, needle in [
-        ("render {d}/r/fold_path.npz --step abc", "--step"),
-        ("render {d}/r/fold_path.npz --step 1.5", "--step"),
+        (
+            "render {d}/r/fold_path.npz --step abc",
+            "unable to parse string as an integer (got 'abc')",
+        ),
+        ("render {d}/r/fold_path.npz --step 1.5", "'1.5'"),
         ("render {d}/r/fold_path.npz --step ''", "--step"),
-        ("render {d}/r/fold_path.npz --step 1e3", "--step"),
+        ("render {d}/r/fold_path.npz --step 1e3", "'1e3'"),
         ("render {d}/r/fold_path.npz --step 99", "--step 99"),
         ("render {d}/r/fold_path.npz --step -99", "--step -99"),
-        ("study {d}/st/unknown_key.toml --workers abc", "--workers"),
-        ("study {d}/st/unknown_key.toml --workers 2.5", "--workers"),
-        ("study {d}/st/unknown_key.toml --batch-size x", "--batch-size"),
-        ("info {d}/valid.fold --merge-tol abc", "--merge-tol"),
-        ("info {d}/valid.fold --merge-tol 1,2", "--merge-tol"),
+        ("study {d}/st/unknown_key.toml --workers abc", "'abc'"),
+        ("study {d}/st/unknown_key.toml --workers 2.5", "'2.5'"),
+        ("study {d}/st/unknown_key.toml --batch-size x", "(got 'x')"),
+        ("info {d}/valid.fold --merge-tol abc", "'abc'"),
+        ("info {d}/valid.fold --merge-tol 1,2", "'1,2'"),
         ("info {d}/valid.fold --merge-tol -1", "merge_tol"),
         ("info {d}/valid.fold --merge-tol nan", "merge_tol"),
         ("info {d}/valid.fold --merge-tol inf", "merge_tol"),
         ("fold {d}/s/ok.toml --form-only=maybe", "--form-only"),
         ("render {d}/r/fold_path.npz --gif=no", "--gif"),
+        ("render {d}/r/fold_path.npz --step=abc", "(got 'abc')"),
+        ("dof {d}/valid.fold --png {d}/out.fold", ".png, .svg or .pdf"),
+        ("dof {d}/valid.fold --png {d}/out", ".png, .svg or .pdf"),
+        ("dof {d}/valid.fold --png {d}/out.txt", "--png"),
+        ("verify --list --case nosuchcase", "nosuchcase"),
     ]:
         add(Row(f"bad-value-{argv.split()[0]}-{argv.split()[-1]}", argv, needle))
     # extra arguments
@@ -654,7 +669,8 @@ def _rows() -> list[Row]:
                     xfail=xf,
                 )
             )
-    add(Row("info-dir", "info {d}/a_dir.fold", "a_dir.fold"))
+    add(Row("info-dir", "info {d}/a_dir.fold", "a_dir.fold: is a folder"))
+    add(Row("dof-dir", "dof {d}/a_dir.fold", "a_dir.fold: is a folder"))
     # --- scenes
     # (--out under a file: a scene accepted by mistake fails fast, before writing results)
     for name in SCENES:
@@ -1004,3 +1020,9 @@ def test_no_convergence_writes_partial_results(capsys, monkeypatch, d, tmp_path)
         ["fold", str(d / "s" / "no_convergence.toml"), "--out", str(tmp_path)], capsys
     )
     assert code == 3 and "partial results" in err and (tmp_path / "fold_path.npz").is_file()
+
+
+def test_verify_list_honours_case(capsys):
+    # --list used to list every case whatever --case said
+    main(["verify", "--list", "--case", "miura_rigid", "--json"])
+    assert list(json.loads(capsys.readouterr().out)) == ["miura_rigid"]

@@ -155,3 +155,30 @@ def test_sigint_writes_the_converged_steps_and_exits_130(tmp_path):
     man = read_manifest(out)
     assert man["converged"] is False and man["reason"] == "interrupted"
     assert one_run(out, {"miura-2x2": 25}) == "miura-2x2" and man["n_states"] == 4
+
+
+SIGTERM_AT_STEP = SIGINT_AT_STEP.replace("signal.SIGINT", "signal.SIGTERM").replace(
+    "Ctrl-C sends it", "kill PID sends it"
+)
+
+
+def test_sigterm_behaves_like_ctrl_c_and_exits_143(tmp_path):
+    """``kill PID`` (SIGTERM) during the solve writes the converged steps through the atomic
+    writer, as Ctrl-C does, and exits with 143 (128 + 15)."""
+    scene = miura_scene(tmp_path, n=2, steps=8)
+    out = tmp_path / "out"
+    r = subprocess.run(
+        [sys.executable, "-c", SIGTERM_AT_STEP, str(scene), "--out", str(out)],
+        env=ENV,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert r.returncode == 143, r.stderr
+    assert "interrupted (SIGTERM) after 3 converged steps" in r.stderr
+    assert "Traceback" not in r.stderr
+    man = read_manifest(out)
+    assert man["converged"] is False and man["reason"] == "interrupted"
+    assert "SIGTERM" in man["message"]
+    assert one_run(out, {"miura-2x2": 25}) == "miura-2x2" and man["n_states"] == 4
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []

@@ -107,3 +107,19 @@ def test_a_record_with_nan_from_an_older_version_is_rerun(tmp_path: Path) -> Non
     rep = run_study(study, out=out, mode="serial")
     assert (rep.skipped, rep.done) == (0, 1)
     assert strict_load(path)["result"]["y"] == 0.0
+
+
+def test_a_key_the_point_function_does_not_take_stops_the_study(tmp_path: Path) -> None:
+    """A ``[grid]`` key the function does not accept used to fail every point (TypeError)
+    while the study exited 0; now it is a ConfigError before anything runs or is written."""
+    out = tmp_path / "out"
+    bad = Study(function="sweep_points:square", grid={"x": [1], "bogus": [1]}, paths=(str(HERE),))
+    with pytest.raises(ConfigError, match=r"\[grid\] key 'bogus'.*takes x, marker_dir"):
+        run_study(bad, out=out, mode="serial")
+    assert not out.exists()
+    none = Study(function="sweep_points:square", fixed={"delay": 0.0}, paths=(str(HERE),))
+    with pytest.raises(ConfigError, match="needs 'x', which no"):
+        run_study(none, out=out, mode="serial")
+    # a function taking **kwargs accepts any key
+    ok = Study(function="json:dumps", grid={"obj": [1], "anything": [2]})
+    assert run_study(ok, out=out, mode="serial").failed == 1  # json.dumps(anything=2) fails
