@@ -46,6 +46,12 @@ FULL_JSON = ROOT / "docs" / "transformations.json"
 
 
 # ------------------------------------------------------------------------------ the runs
+# inverse design targets (pattern, k1 L, k2 L): a saddle, an arch, a dome a Miura cannot take,
+# a dome (full mode only: ~3 min)
+DESIGNS = [("yoshimura", 0.2, -3.0), ("miura_arc", 0.0, -0.6), ("miura", -0.5, -0.5),
+           ("resch", -0.5, -1.5)]  # fmt: skip
+
+
 def settings(quick: bool) -> dict:
     """Grid and subsets of one mode."""
     pats = list(PATTERNS)
@@ -64,6 +70,7 @@ def settings(quick: bool) -> dict:
             "surface_patterns": ["miura", "resch"],
             "surfaces": [(0.0, 0.0), (1.0, 1.0), (1.0, -1.0)],
             "placement_patterns": ["miura", "yoshimura"],
+            "designs": DESIGNS[:3],
             "steps": 6,
         }
     kl = [-1.0, 0.0, 0.5, 1.0, 1.5]
@@ -76,6 +83,7 @@ def settings(quick: bool) -> dict:
         "surface_patterns": pats,
         "surfaces": [(0.0, 0.0), (1.0, 1.0), (1.0, -1.0), (-1.0, -1.0)],
         "placement_patterns": pats,
+        "designs": DESIGNS,
         "steps": 8,
     }
 
@@ -120,6 +128,8 @@ def runs(quick: bool) -> list[dict]:
         for n in placement_counts(p, quick):
             for pl in ("dof", "section"):
                 pts.append({"kind": "placement", "pattern": p, "count": n, "placement": pl})
+    for p, k1, k2 in s["designs"]:
+        pts.append({"kind": "design", "pattern": p, "target_k1L": k1, "target_k2L": k2})
     return pts
 
 
@@ -156,7 +166,7 @@ def index(records: dict) -> dict:
 
 def get(ix: dict, **prm) -> dict | None:
     """The result of one run (None if it failed or is missing)."""
-    full = prm if prm.get("kind") == "placement" else _form(**prm)
+    full = prm if prm.get("kind") in ("placement", "design") else _form(**prm)
     rec = ix.get(key(full))
     return rec["result"] if rec and rec["status"] == "ok" else None
 
@@ -224,7 +234,7 @@ def headline(records: dict, quick: bool) -> dict:
             continue
         prm = {k: v for k, v in rec["params"].items() if k not in ("quick", "steps")}
         r = rec["result"]
-        keep = ("KL2", "actuator_misfit_deg", "form_error_deg", "model_label")
+        keep = ("KL2", "actuator_misfit_deg", "form_error_deg", "model_label", "relative_error")
         out[json.dumps(prm, sort_keys=True)] = {k: r[k] for k in keep if k in r}
     return out
 
@@ -348,6 +358,26 @@ def table_placement(rows: list[dict]) -> str:
             + ", ".join(_f(v, ".2g") for v in r["section"])
             + " | "
             + f"{r['dof_needed'] or 'not reached'} | {r['section_needed'] or 'not reached'} |"
+        )
+    return "\n".join(lines)
+
+
+def table_design(ix: dict, s: dict) -> str:
+    lines = [
+        "| pattern | actuators (bh.dof) | target k1 L, k2 L | achieved k1 L, k2 L | "
+        "error | reached | forward solves | why not |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for p, k1, k2 in s["designs"]:
+        r = get(ix, kind="design", pattern=p, target_k1L=k1, target_k2L=k2)
+        if r is None:
+            lines.append(f"| {p} | | {_f(k1, 'g')}, {_f(k2, 'g')} | failed | | | | |")
+            continue
+        a = r["achieved"]
+        lines.append(
+            f"| {p} | {r['n_actuators']} | {_f(k1, 'g')}, {_f(k2, 'g')} | "
+            f"{_f(a[0], '.4g')}, {_f(a[1], '.4g')} | {_f(100 * r['relative_error'], '.2g')} % | "
+            f"{'yes' if r['reached'] else 'no'} | {r['evaluations']} | {r['reason'] or ''} |"
         )
     return "\n".join(lines)
 
@@ -490,6 +520,7 @@ def publish(records: dict, quick: bool) -> None:
         "surfaces": table_surfaces(ix, s),
         "placement": table_placement(placement_rows(ix, s, quick)),
         "signs": table_signs(ix, records),
+        "design": table_design(ix, s),
         "failed": "\n".join(
             f"* {json.dumps(key(r['params']))}: {r['error']['type']}: "
             f"{r['error']['message'].splitlines()[0][:160]}"
@@ -539,6 +570,8 @@ def main(argv: list[str] | None = None) -> int:
         table_placement(placement_rows(ix, s, a.quick)),
         "",
         table_signs(ix, records),
+        "",
+        table_design(ix, s),
         sep="\n",
     )
     failed = [r for r in records.values() if r["status"] != "ok"]

@@ -265,10 +265,14 @@ def placement_point(
 
 
 def cell(kind: str, pattern: str, quick: bool = True, steps: int = 6, **params) -> dict:
-    """One run of the study: ``kind`` is ``"form"`` (:func:`point`) or ``"placement"``
-    (:func:`placement_point`)."""
+    """One run of the study: ``kind`` is ``"form"`` (:func:`point`), ``"placement"``
+    (:func:`placement_point`) or ``"design"`` (``design.design``, on the quick-size sheets)."""
     if kind == "form":
         return point(pattern, quick=quick, steps=steps, **params)
     if kind == "placement":
         return placement_point(pattern, quick=quick, steps=steps, **params)
-    raise ValueError(f"kind must be 'form' or 'placement', got {kind!r}")
+    if kind == "design":
+        from design import design
+
+        return design(pattern, quick=True, **params)  # always on the small sheets
+    raise ValueError(f"kind must be 'form', 'placement' or 'design', got {kind!r}")

@@ -125,3 +125,19 @@ def test_dof_placement_fixes_the_form_and_section_lines_do_not(run_mod) -> None:
         res = _recompute(transform, p)
         _check(res, _published(p))
         assert (res["form_error_deg"] < 1e-6) == fixed
+
+
+def test_inverse_design_reaches_an_arch_and_says_why_a_miura_cannot_be_a_dome(run_mod) -> None:
+    """miura_arc: the arch k2 L = -0.6 (k1 = 0) is reached by the one bh.dof actuator; a Miura
+    sheet asked for a dome is not, with the reason (its rigid folds are globally flat)."""
+    _, transform = run_mod
+    for pattern, k1, k2, reached in (("miura_arc", 0.0, -0.6, True), ("miura", -0.5, -0.5, False)):
+        p = {"kind": "design", "pattern": pattern, "target_k1L": k1, "target_k2L": k2}
+        res = _recompute(transform, p)
+        _check(res, _published(p))
+        assert res["reached"] is reached
+        assert (res["relative_error"] <= 0.05) is reached
+        if not reached:
+            assert "does not respond to the actuators" in res["reason"]
+    p = {"kind": "design", "pattern": "yoshimura", "target_k1L": 0.2, "target_k2L": -3.0}
+    assert _published(p)["relative_error"] < 0.05  # published only (8 s)
