@@ -416,16 +416,15 @@ def figure_convergence(rows: list[dict], s: dict, path: Path, stamp: str) -> Non
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(6.5, 4.5), layout="constrained")
+    colour = {p: f"C{i}" for i, p in enumerate(PATTERNS)}
+    seen = set()
     for row in rows:
         if row["ok"]:
             ls = "-" if row["misfit_deg"] < 1e-6 else ":"
-            ax.loglog(
-                s["ratios"],
-                np.maximum(row["drho_deg"], 1e-12),
-                "o" + ls,
-                label=f"{row['pattern']} κL={row['kappa_L']:g}",
-                ms=3,
-            )
+            p = row["pattern"]
+            ax.loglog(s["ratios"], np.maximum(row["drho_deg"], 1e-12), "o" + ls, ms=3,
+                      color=colour[p], label=None if p in seen else p)  # fmt: skip
+            seen.add(p)
     r = np.asarray(s["ratios"])
     ax.loglog(r, 10 * r[0] / r, "k--", lw=0.8, label="slope −1")
     ax.set(
@@ -473,7 +472,7 @@ def figure_forms(ix: dict, s: dict, quick: bool, path: Path, stamp: str) -> None
             ax.set(xlim=(c[0] - h, c[0] + h), ylim=(c[1] - h, c[1] + h), zlim=(c[2] - h, c[2] + h))
             ax.view_init(elev=25, azim=-60)
             ax.set_title(
-                f"{p} κL={k:g}\nKL²={r['KL2']:.2g}, misfit {r['actuator_misfit_deg']:.2g}°",
+                f"{p} κL={k:g}\nKL²={_f(r['KL2'], '.2g')}, misfit {r['actuator_misfit_deg']:.2g}°",
                 fontsize=6,
             )
     fig.suptitle(f"Rigid-limit forms (spacing 1) — {stamp}", fontsize=8)
@@ -488,6 +487,13 @@ def replace_block(text: str, name: str, content: str) -> str:
     if not pat.search(text):
         raise KeyError(f"docs/transformations.md has no block {name!r}")
     return pat.sub(lambda m: m.group(1) + content.rstrip() + "\n" + m.group(2), text)
+
+
+def _describe(prm: dict) -> str:
+    """``pattern kind, key = value, ...`` of a run (for the list of failed runs)."""
+    skip = ("pattern", "kind", "quick", "steps")
+    rest = ", ".join(f"{k} = {v}" for k, v in prm.items() if k not in skip and v is not None)
+    return f"{prm['pattern']} ({prm['kind']}): {rest}"
 
 
 def stamp_text() -> str:
@@ -522,7 +528,7 @@ def publish(records: dict, quick: bool) -> None:
         "signs": table_signs(ix, records),
         "design": table_design(ix, s),
         "failed": "\n".join(
-            f"* {json.dumps(key(r['params']))}: {r['error']['type']}: "
+            f"* {_describe(r['params'])}: {r['error']['type']}: "
             f"{r['error']['message'].splitlines()[0][:160]}"
             for r in records.values()
             if r["status"] != "ok"

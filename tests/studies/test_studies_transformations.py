@@ -141,3 +141,13 @@ def test_inverse_design_reaches_an_arch_and_says_why_a_miura_cannot_be_a_dome(ru
             assert "does not respond to the actuators" in res["reason"]
     p = {"kind": "design", "pattern": "yoshimura", "target_k1L": 0.2, "target_k2L": -3.0}
     assert _published(p)["relative_error"] < 0.05  # published only (8 s)
+
+
+def test_every_table_of_the_doc_is_written_and_stamped() -> None:
+    import re
+
+    text = (ROOT / "docs" / "transformations.md").read_text()
+    blocks = re.findall(r"<!-- BEGIN (\w+) -->\n(.*?)<!-- END \1 -->", text, flags=re.S)
+    assert {b for b, _ in blocks} >= {"stamp", "rigid", "convergence", "placement", "design"}
+    assert all(body.strip() for _, body in blocks), "rerun `run.py --publish`"
+    assert re.search(r"barhinge \d+\.\d+\.\d+, \d{4}-\d\d-\d\d", dict(blocks)["stamp"])
