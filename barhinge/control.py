@@ -51,6 +51,7 @@ __all__ = [
     "Chain",
     "CircularArc",
     "ControlCurve",
+    "ControlSurface",
     "Parabola",
     "SplineCurve",
     "chain_on_curve",
@@ -62,6 +63,7 @@ __all__ = [
     "section_crossings",
     "section_lines",
     "spaced_lines",
+    "surface_actuators",
     "synchronised",
     "turning_angles",
 ]
@@ -576,3 +578,90 @@ def current_angles_deg(cp: CreasePattern, edges: Sequence[int] | np.ndarray) -> 
     ramp from the current state instead of the flat one.
     """
     return cp.state_fold_angles()[np.asarray(edges, dtype=np.int64)]
+
+
+# ------------------------------------------------------------------------------ surfaces
+@dataclasses.dataclass(frozen=True)
+class ControlSurface:
+    """Paraboloid ``z = (kx x^2 + ky y^2) / 2`` over the flat pattern (origin: its centre).
+
+    ``kx``, ``ky`` (1/length) are the principal curvatures at the apex, along the section
+    directions ``e`` and ``n = (-e_y, e_x)``: ``kx * ky > 0`` asks for a synclastic (dome,
+    ``K > 0``) form, ``kx * ky < 0`` for an anticlastic (saddle, ``K < 0``) one. Its two
+    principal sections through the apex are the control curves ``Parabola(kx)`` and
+    ``Parabola(ky)`` (see :func:`surface_actuators`).
+    """
+
+    kx: float
+    ky: float
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "kx", _check.number(self.kx, "kx"))
+        object.__setattr__(self, "ky", _check.number(self.ky, "ky"))
+
+    @property
+    def gaussian_curvature(self) -> float:
+        """``kx * ky``: the Gaussian curvature asked for at the apex (1/length^2)."""
+        return self.kx * self.ky
+
+    def sections(self) -> tuple[Parabola, Parabola]:
+        """The principal sections through the apex, along ``e`` and along ``n``."""
+        return Parabola(self.kx), Parabola(self.ky)
+
+    def scaled(self, s: float) -> ControlSurface:
+        return ControlSurface(self.kx * s, self.ky * s)
+
+
+def surface_actuators(
+    cp: CreasePattern,
+    surface: ControlSurface,
+    *,
+    direction: Sequence[float] = (1.0, 0.0),
+    edges: tuple[Sequence[int] | np.ndarray, Sequence[int] | np.ndarray] | None = None,
+    mapping: Mapping = "turning",
+    amplitude_deg: float = 90.0,
+) -> Actuators:
+    """Actuators on two crossing sections whose fold angles put them on a control surface.
+
+    The first section runs along ``e = direction`` through the middle of the pattern and its
+    crossed creases (:func:`section_crossings`) get the turning angles of the section curve
+    ``Parabola(kx)``; the second runs along ``n = (-e_y, e_x)`` with ``Parabola(ky)``. A
+    crease crossed by both sections keeps the first one's angle.
+
+    Parameters
+    ----------
+    cp : CreasePattern, flat
+    surface : ControlSurface
+    direction : (2,) float
+        Direction ``e`` of the first section.
+    edges : pair of (k,) int, optional
+        Actuated creases of each section (default: every crease each section line crosses).
+    mapping, amplitude_deg : see :func:`curve_actuators`.
+
+    Returns
+    -------
+    Actuators
+        ``targets_deg`` per edge (valley > 0): the rotation angles only; add a base fold for
+        a folded form.
+    """
+    e = _unit(direction)
+    n = np.array([-e[1], e[0]])
+    out_e: list[np.ndarray] = []
+    out_t: list[np.ndarray] = []
+    for k, (d, curve) in enumerate(zip((e, n), surface.sections(), strict=True)):
+        if edges is None:
+            E, _, _ = section_crossings(cp, direction=d)
+        else:
+            E = np.asarray(edges[k], dtype=np.int64).ravel()
+        if out_e:
+            E = E[~np.isin(E, np.concatenate(out_e))]
+        if E.size == 0:
+            continue
+        acts = curve_actuators(
+            cp, E, curve, direction=d, mapping=mapping, amplitude_deg=amplitude_deg
+        )
+        out_e.append(acts.edges)
+        out_t.append(acts.targets_deg)
+    if not out_e:
+        raise PatternError("neither section of the control surface crosses a crease")
+    return Actuators(edges=np.concatenate(out_e), targets_deg=np.concatenate(out_t))

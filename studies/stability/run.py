@@ -560,9 +560,7 @@ SCENARIOS: list[Scenario] = [
         "converged",
         lambda: large_step(8),
     ),  # fmt: skip
-    Scenario(
-        "soft-folds", "fold-angle control", "k_fold = 0 (Miura 2x2)", "converged", soft_folds
-    ),
+    Scenario("soft-folds", "fold-angle control", "k_fold = 0 (Miura 2x2)", "converged", soft_folds),
     Scenario(
         "stiff-folds",
         "fold-angle control",

@@ -1,196 +1,593 @@
-"""Six tessellations driven by actuators on a control curve: spacing x curvature.
+"""Six tessellations driven by actuators on control curves and surfaces, on one model.
 
 For each pattern (three Miura-ori variations, a Russo-style optical-illusion pleat, Yoshimura
 and Ron Resch) a section line across the middle of the flat sheet (along +x) crosses the
-creases at points P; every ``spacing``-th crossing is an actuator. Each actuator's target is a
-synchronised base fold plus the control-curve rotation angle (barhinge.control):
+creases at points P; every ``spacing``-th crossing is an actuator, driven to
 
-    rho_i = s_i * BASE_DEG + Phi_i(kappa),    s_i = +1 valley, -1 mountain,
+    rho_i = s_i * 30 deg + Phi_i,    s_i = +1 valley, -1 mountain,
 
-with ``Phi_i`` the turning angle that puts the actuator points on a circle of curvature
-``kappa = kappa_L / L`` (``L`` = width of the sheet along the section; ``kappa_L = 0`` is the
-synchronised mode). The sheet is folded with rigid kinematics (``bh.rigid_fold``: planar
-panels; if that fails, panels may bend along diagonals, ``triangulated=True``); the other
-creases follow the minimum-norm motion. Per run: Gaussian curvature of the global form
-(``bh.gaussian_curvature``, quadratic fit through facet centroids), the spread of fold angles
-among repeated creases (non-synchronised local folding), and the error if the run failed.
+with ``Phi_i`` the turning angle that puts the actuator points on a control curve (circle,
+parabola or spline) of apex curvature ``kappa = kappa_L / L`` (``L`` = sheet width along the
+section). A control surface (two section lines, along x and y, with curvatures ``kappa_L / L``
+and ``ky_L / L_y``) asks for synclastic or anticlastic forms.
 
-Run: ``python studies/transformations/run.py [--quick] [--serial] [--workers N]
-[--retry-failed]`` (a rerun skips finished runs; ``--retry-failed`` reruns failed ones; full mode
-writes pictures next to this file under results/ and into docs/img/). Importing the module
-runs the quick mode (results in ``$BARHINGE_STUDY_OUT`` or a temporary folder).
+Every cell is folded by the energy-minimising rigid limit (``bh.rigid_fold`` with the
+bar-and-hinge model's fold stiffnesses; incompatible targets met in least squares, the misfit
+recorded), and a subset also by the bar-and-hinge model at several stiffness ratios (bars and
+panel bending ``r`` times the default) to show how it approaches the rigid limit. A second
+part compares actuators chosen by the DOF analysis (``bh.dof``) with section-line placement
+at the same count (form error against a reference rigid form).
+
+Run ``python studies/transformations/run.py --help``. A rerun skips finished runs.
+``--publish`` writes the tables, figures and numbers of docs/transformations.md (full mode) or
+the published quick numbers docs/transformations-quick.json (with ``--quick``), which
+tests/studies/test_studies_transformations.py recomputes.
 """
 
 from __future__ import annotations
 
-import os
+import argparse
+import datetime
+import json
+import re
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
 sys.path.insert(0, str(HERE))
 from transform import PATTERNS, make_pattern  # noqa: E402
 
-MAIN = __name__ == "__main__"
-QUICK = not MAIN or "--quick" in sys.argv
-
-SPACINGS = [1] if QUICK else [1, 2, 3]
-KAPPA_L = [0.0, 1.0] if QUICK else [-1.0, 0.0, 0.5, 1.0, 1.5]
-STEPS = 6 if QUICK else 12
-KEYS = ("K", "KL2", "nonsync_deg", "max_angle_defect_deg")
+DOC = ROOT / "docs" / "transformations.md"
+QUICK_JSON = ROOT / "docs" / "transformations-quick.json"
+FULL_JSON = ROOT / "docs" / "transformations.json"
 
 
-def study():
-    from barhinge.sweep import Study
+# ------------------------------------------------------------------------------ the runs
+# inverse design targets (pattern, k1 L, k2 L): a saddle, an arch, a dome a Miura cannot take,
+# a dome (full mode only: ~3 min)
+DESIGNS = [("yoshimura", 0.2, -3.0), ("miura_arc", 0.0, -0.6), ("miura", -0.5, -0.5),
+           ("resch", -0.5, -1.5)]  # fmt: skip
 
-    return Study(
-        function="transform:point",
-        grid={"pattern": list(PATTERNS), "spacing": SPACINGS, "kappa_L": KAPPA_L},
-        fixed={"quick": QUICK, "steps": STEPS},
-        name="transformations-quick" if QUICK else "transformations",
+
+def settings(quick: bool) -> dict:
+    """Grid and subsets of one mode."""
+    pats = list(PATTERNS)
+    if quick:
+        return {
+            "spacings": [1],
+            "kappa_L": [0.0, 1.0],
+            "ratios": [10.0, 100.0],
+            "bh_cells": [
+                ("miura", 1, 0.0),
+                ("miura", 1, 1.0),
+                ("yoshimura", 1, 1.0),
+                ("resch", 1, 1.0),
+            ],
+            "curve_patterns": ["miura", "resch"],
+            "surface_patterns": ["miura", "resch"],
+            "surfaces": [(0.0, 0.0), (1.0, 1.0), (1.0, -1.0)],
+            "placement_patterns": ["miura", "yoshimura"],
+            "designs": DESIGNS[:3],
+            "steps": 6,
+        }
+    kl = [-1.0, 0.0, 0.5, 1.0, 1.5]
+    return {
+        "spacings": [1, 2, 3],
+        "kappa_L": kl,
+        "ratios": [10.0, 100.0, 1000.0],
+        "bh_cells": [(p, 1, k) for p in pats for k in kl],
+        "curve_patterns": pats,
+        "surface_patterns": pats,
+        "surfaces": [(0.0, 0.0), (1.0, 1.0), (1.0, -1.0), (-1.0, -1.0)],
+        "placement_patterns": pats,
+        "designs": DESIGNS,
+        "steps": 8,
+    }
+
+
+def _form(pattern, spacing=1, curve="circle", kappa_L=0.0, ky_L=None, model="rigid"):
+    return {
+        "kind": "form",
+        "pattern": pattern,
+        "spacing": spacing,
+        "curve": curve,
+        "kappa_L": kappa_L,
+        "ky_L": ky_L,
+        "model": model,
+    }
+
+
+def placement_counts(pattern: str, quick: bool) -> list[int]:
+    import barhinge as bh
+
+    n = len(bh.dof(make_pattern(pattern, quick)).mechanism.actuators)
+    return sorted({1, max(1, n // 2), n})
+
+
+def runs(quick: bool) -> list[dict]:
+    """Every run of one mode (each a point of the sweep)."""
+    s = settings(quick)
+    pts = [
+        _form(p, sp, "circle", k) for p in PATTERNS for sp in s["spacings"] for k in s["kappa_L"]
+    ]
+    pts += [_form(p, sp, "circle", k, model=r) for p, sp, k in s["bh_cells"] for r in s["ratios"]]
+    for p in s["curve_patterns"]:
+        for c in ("parabola", "spline"):
+            pts.append(_form(p, 1, c, 1.0))
+            if not quick:
+                pts.append(_form(p, 1, c, 1.0, model=100.0))
+    for p in s["surface_patterns"]:
+        for kx, ky in s["surfaces"]:
+            pts.append(_form(p, 1, "parabola", kx, ky))
+            if not quick:
+                pts.append(_form(p, 1, "parabola", kx, ky, model=100.0))
+    for p in s["placement_patterns"]:
+        for n in placement_counts(p, quick):
+            for pl in ("dof", "section"):
+                pts.append({"kind": "placement", "pattern": p, "count": n, "placement": pl})
+    for p, k1, k2 in s["designs"]:
+        pts.append({"kind": "design", "pattern": p, "target_k1L": k1, "target_k2L": k2})
+    return pts
+
+
+def run(quick: bool, out: Path, serial: bool, workers: int | None, retry_failed: bool):
+    from barhinge.sweep import Study, read_records, run_study
+
+    study = Study(
+        function="transform:cell",
+        points=tuple(runs(quick)),
+        fixed={"quick": quick, "steps": settings(quick)["steps"]},
+        name="transformations-quick" if quick else "transformations",
         batch_size=1,
         paths=(str(HERE),),
     )
+    report = run_study(
+        study,
+        out=out,
+        mode="serial" if serial else "local",
+        workers=workers,
+        retry_failed=retry_failed,
+    )
+    return report, read_records(out)
 
 
-def collect(records: dict) -> tuple[dict, list]:
-    """Arrays over the grid (NaN where a run failed) per pattern, and the failures."""
-    res = {p: {k: np.full((len(SPACINGS), len(KAPPA_L)), np.nan) for k in KEYS} for p in PATTERNS}
-    failed = []
+# ------------------------------------------------------------------------------ results
+def key(prm: dict) -> tuple:
+    """Hashable id of a run from its parameters (without quick/steps)."""
+    return tuple((k, prm[k]) for k in sorted(prm) if k not in ("quick", "steps"))
+
+
+def index(records: dict) -> dict:
+    return {key(r["params"]): r for r in records.values()}
+
+
+def get(ix: dict, **prm) -> dict | None:
+    """The result of one run (None if it failed or is missing)."""
+    full = prm if prm.get("kind") in ("placement", "design") else _form(**prm)
+    rec = ix.get(key(full))
+    return rec["result"] if rec and rec["status"] == "ok" else None
+
+
+def slope(ratios: list[float], errors: list[float]) -> float:
+    """Log-log slope of the distance to the rigid limit against the stiffness ratio."""
+    e = np.asarray(errors, float)
+    if len(e) < 2 or np.any(~np.isfinite(e)) or np.any(e <= 0):
+        return float("nan")
+    return float(np.polyfit(np.log(ratios), np.log(e), 1)[0])
+
+
+def convergence(ix: dict, s: dict) -> list[dict]:
+    """Per bar-and-hinge cell: distance of the fold angles and of K L^2 to the rigid limit."""
+    rows = []
+    for p, sp, k in s["bh_cells"]:
+        rig = get(ix, pattern=p, spacing=sp, kappa_L=k)
+        bhs = [get(ix, pattern=p, spacing=sp, kappa_L=k, model=r) for r in s["ratios"]]
+        if rig is None or any(b is None for b in bhs):
+            rows.append({"pattern": p, "spacing": sp, "kappa_L": k, "ok": False})
+            continue
+        d = [float(np.max(np.abs(np.asarray(b["rho_deg"]) - rig["rho_deg"]))) for b in bhs]
+        rows.append(
+            {
+                "pattern": p,
+                "spacing": sp,
+                "kappa_L": k,
+                "ok": True,
+                "misfit_deg": rig["actuator_misfit_deg"],
+                "KL2_rigid": rig["KL2"],
+                "KL2_bh": [b["KL2"] for b in bhs],
+                "drho_deg": d,
+                "slope": slope(s["ratios"], d),
+            }
+        )
+    return rows
+
+
+def placement_rows(ix: dict, s: dict, quick: bool) -> list[dict]:
+    rows = []
+    for p in s["placement_patterns"]:
+        counts = placement_counts(p, quick)
+        row = {"pattern": p, "n_dof": counts[-1], "counts": counts}
+        for pl in ("dof", "section"):
+            res = [get(ix, kind="placement", pattern=p, count=n, placement=pl) for n in counts]
+            row[pl] = [None if r is None else r["form_error_deg"] for r in res]
+            fixed = [
+                n
+                for n, r in zip(counts, res, strict=True)
+                if r is not None and r["form_error_deg"] < 1e-3
+            ]
+            row[f"{pl}_needed"] = fixed[0] if fixed else None
+            row[f"{pl}_KL2"] = [None if r is None else r["KL2"] for r in res]
+        ref = get(ix, kind="placement", pattern=p, count=counts[-1], placement="dof")
+        row["KL2_reference"] = None if ref is None else ref["KL2_reference"]
+        rows.append(row)
+    return rows
+
+
+def headline(records: dict, quick: bool) -> dict:
+    """The numbers a test recomputes: per run key, the main scalars."""
+    out = {}
     for rec in records.values():
-        prm = rec["params"]
-        i, j = SPACINGS.index(prm["spacing"]), KAPPA_L.index(prm["kappa_L"])
-        if rec["status"] == "ok":
-            for k in KEYS:
-                res[prm["pattern"]][k][i, j] = rec["result"][k]
-        else:
-            failed.append((prm["pattern"], prm["spacing"], prm["kappa_L"], rec["error"]))
-    return res, sorted(failed, key=lambda f: (list(PATTERNS).index(f[0]), f[1], f[2]))
+        if rec["status"] != "ok":
+            continue
+        prm = {k: v for k, v in rec["params"].items() if k not in ("quick", "steps")}
+        r = rec["result"]
+        keep = ("KL2", "actuator_misfit_deg", "form_error_deg", "model_label", "relative_error")
+        out[json.dumps(prm, sort_keys=True)] = {k: r[k] for k in keep if k in r}
+    return out
 
 
-# ------------------------------------------------------------------------------ run
-from barhinge.sweep import read_records, run_study  # noqa: E402
-
-OUT = Path(
-    os.environ.get("BARHINGE_STUDY_OUT")
-    or (HERE / ("results-quick" if QUICK else "results") if MAIN else tempfile.mkdtemp())
-)
-REPORT = run_study(
-    study(),
-    out=OUT,
-    mode="serial" if (QUICK or "--serial" in sys.argv) else "local",
-    retry_failed="--retry-failed" in sys.argv,
-    workers=int(sys.argv[sys.argv.index("--workers") + 1]) if "--workers" in sys.argv else None,
-)
-RECORDS = {k: v for k, v in read_records(OUT).items()}
-RESULTS, FAILED = collect(RECORDS)
+# ------------------------------------------------------------------------------ tables
+def _f(v, fmt=".3g") -> str:
+    if v is None or (isinstance(v, float) and not np.isfinite(v)):
+        return "–"
+    if isinstance(v, float) and abs(v) < 5e-10:
+        return "0"
+    return format(v, fmt).replace("-", "−")
 
 
-# ------------------------------------------------------------------------------ pictures
-def _faces_poly(cp, X):
-    return [X[list(f)] for f in cp.faces]
+def table_rigid(ix: dict, s: dict) -> str:
+    """K L^2 of the rigid limit and the actuator misfit, per pattern x spacing x kappa L."""
+    head = "| pattern | spacing | " + " | ".join(f"κL = {_f(k, 'g')}" for k in s["kappa_L"]) + " |"
+    lines = [head, "|---|---|" + "---|" * len(s["kappa_L"])]
+    for p in PATTERNS:
+        for sp in s["spacings"]:
+            cells = []
+            for k in s["kappa_L"]:
+                r = get(ix, pattern=p, spacing=sp, kappa_L=k)
+                if r is None:
+                    cells.append("failed")
+                    continue
+                m = r["actuator_misfit_deg"]
+                cells.append(_f(r["KL2"]) + ("" if m < 1e-6 else f" ({_f(m, '.2g')}°)"))
+            lines.append(f"| {p} | {sp} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
 
 
-def picture_grid(pattern: str, path: Path) -> None:
+def table_convergence(rows: list[dict], s: dict) -> str:
+    rs = s["ratios"]
+    head = (
+        "| pattern | κL | misfit (deg) | K L² rigid | "
+        + " | ".join(f"K L² r = {r:g}" for r in rs)
+        + " | "
+        + " | ".join(f"max Δρ r = {r:g}" for r in rs)
+        + " | slope |"
+    )
+    lines = [head, "|---|---|---|---|" + "---|" * (2 * len(rs) + 1)]
+    for row in rows:
+        if not row["ok"]:
+            lines.append(
+                f"| {row['pattern']} | {_f(row['kappa_L'], 'g')} | failed |"
+                + " |" * (2 * len(rs) + 2)
+            )
+            continue
+        lines.append(
+            f"| {row['pattern']} | {_f(row['kappa_L'], 'g')} | {_f(row['misfit_deg'], '.2g')} | "
+            f"{_f(row['KL2_rigid'])} | "
+            + " | ".join(_f(v) for v in row["KL2_bh"])
+            + " | "
+            + " | ".join(_f(v, ".2g") for v in row["drho_deg"])
+            + f" | {_f(row['slope'], '.2f')} |"
+        )
+    return "\n".join(lines)
+
+
+def table_curves(ix: dict, s: dict) -> str:
+    lines = ["| pattern | model | circle | parabola | spline |", "|---|---|---|---|---|"]
+    for p in s["curve_patterns"]:
+        for model in ("rigid", 100.0):
+            res = [
+                get(ix, pattern=p, curve=c, kappa_L=1.0, model=model)
+                for c in ("circle", "parabola", "spline")
+            ]
+            if all(r is None for r in res):
+                continue
+            name = "rigid limit" if model == "rigid" else f"bar-and-hinge r = {model:g}"
+            cells = [
+                "–"
+                if r is None
+                else _f(r["KL2"])
+                + (
+                    ""
+                    if r["actuator_misfit_deg"] < 1e-6
+                    else f" ({_f(r['actuator_misfit_deg'], '.2g')}°)"
+                )
+                for r in res
+            ]
+            lines.append(f"| {p} | {name} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def table_surfaces(ix: dict, s: dict) -> str:
+    sf = s["surfaces"]
+    head = (
+        "| pattern | model | "
+        + " | ".join(f"κxL, κyL = {_f(a, 'g')}, {_f(b, 'g')}" for a, b in sf)
+        + " |"
+    )
+    lines = [head, "|---|---|" + "---|" * len(sf)]
+    for p in s["surface_patterns"]:
+        for model in ("rigid", 100.0):
+            res = [
+                get(ix, pattern=p, curve="parabola", kappa_L=a, ky_L=b, model=model) for a, b in sf
+            ]
+            if all(r is None for r in res):
+                continue
+            name = "rigid limit" if model == "rigid" else f"bar-and-hinge r = {model:g}"
+            cells = [
+                "–" if r is None else f"{_f(r['KL2'])} ({_f(r['actuator_misfit_deg'], '.2g')}°)"
+                for r in res
+            ]
+            lines.append(f"| {p} | {name} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def table_placement(rows: list[dict]) -> str:
+    lines = [
+        "| pattern | DOF (actuators of bh.dof) | counts | form error, bh.dof placement (deg) "
+        "| form error, section lines (deg) | needed: bh.dof | needed: section |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        lines.append(
+            f"| {r['pattern']} | {r['n_dof']} | {', '.join(map(str, r['counts']))} | "
+            + ", ".join(_f(v, ".2g") for v in r["dof"])
+            + " | "
+            + ", ".join(_f(v, ".2g") for v in r["section"])
+            + " | "
+            + f"{r['dof_needed'] or 'not reached'} | {r['section_needed'] or 'not reached'} |"
+        )
+    return "\n".join(lines)
+
+
+def table_design(ix: dict, s: dict) -> str:
+    lines = [
+        "| pattern | actuators (bh.dof) | target k1 L, k2 L | achieved k1 L, k2 L | "
+        "error | reached | forward solves | why not |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for p, k1, k2 in s["designs"]:
+        r = get(ix, kind="design", pattern=p, target_k1L=k1, target_k2L=k2)
+        if r is None:
+            lines.append(f"| {p} | | {_f(k1, 'g')}, {_f(k2, 'g')} | failed | | | | |")
+            continue
+        a = r["achieved"]
+        lines.append(
+            f"| {p} | {r['n_actuators']} | {_f(k1, 'g')}, {_f(k2, 'g')} | "
+            f"{_f(a[0], '.4g')}, {_f(a[1], '.4g')} | {_f(100 * r['relative_error'], '.2g')} % | "
+            f"{'yes' if r['reached'] else 'no'} | {r['evaluations']} | {r['reason'] or ''} |"
+        )
+    return "\n".join(lines)
+
+
+def table_signs(ix: dict, records: dict) -> str:
+    """Range of K L^2 per pattern over every form run, by model."""
+    lines = [
+        "| pattern | model | runs | K L² min | K L² max | any K > 0 |",
+        "|---|---|---|---|---|---|",
+    ]
+    for p in PATTERNS:
+        for m in ("rigid", "bar-hinge"):
+            ks = [
+                r["result"]["KL2"]
+                for r in records.values()
+                if r["params"]["kind"] == "form"
+                and r["params"]["pattern"] == p
+                and r["status"] == "ok"
+                and r["result"]["model"] == m
+            ]
+            if not ks:
+                continue
+            pos = max(ks) > 1e-3
+            lines.append(
+                f"| {p} | {'rigid limit' if m == 'rigid' else 'bar-and-hinge'} | "
+                f"{len(ks)} | {_f(min(ks))} | {_f(max(ks))} | {'yes' if pos else 'no'} |"
+            )
+    return "\n".join(lines)
+
+
+# ------------------------------------------------------------------------------ figures
+def figure_convergence(rows: list[dict], s: dict, path: Path, stamp: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.5, 4.5), layout="constrained")
+    colour = {p: f"C{i}" for i, p in enumerate(PATTERNS)}
+    seen = set()
+    for row in rows:
+        if row["ok"]:
+            ls = "-" if row["misfit_deg"] < 1e-6 else ":"
+            p = row["pattern"]
+            ax.loglog(s["ratios"], np.maximum(row["drho_deg"], 1e-12), "o" + ls, ms=3,
+                      color=colour[p], label=None if p in seen else p)  # fmt: skip
+            seen.add(p)
+    r = np.asarray(s["ratios"])
+    ax.loglog(r, 10 * r[0] / r, "k--", lw=0.8, label="slope −1")
+    ax.set(
+        xlabel="stiffness ratio r (bars and panels / default)",
+        ylabel="max |ρ_bh − ρ_rigid| over creases (deg)",
+        title="bar-and-hinge → rigid limit (solid: compatible targets; dotted: least squares)",
+    )
+    ax.title.set_fontsize(8)
+    ax.legend(fontsize=6, ncol=2)
+    fig.text(0.99, 0.005, stamp, ha="right", fontsize=6, color="0.4")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def figure_forms(ix: dict, s: dict, quick: bool, path: Path, stamp: str) -> None:
+    """Rigid-limit forms: rows patterns, columns kappa L (spacing 1)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    try:
-        cp = make_pattern(pattern, QUICK)
-    except ImportError:
-        cp = None
-    fig = plt.figure(figsize=(2.6 * len(KAPPA_L), 2.4 * len(SPACINGS)), layout="constrained")
-    for rec in RECORDS.values():
-        prm = rec["params"]
-        if prm["pattern"] != pattern:
-            continue
-        i, j = SPACINGS.index(prm["spacing"]), KAPPA_L.index(prm["kappa_L"])
-        ax = fig.add_subplot(len(SPACINGS), len(KAPPA_L), i * len(KAPPA_L) + j + 1,
-                             projection="3d")  # fmt: skip
-        ax.set_title(f"every {prm['spacing']}, kL = {prm['kappa_L']:g}", fontsize=8)
-        ax.set_axis_off()
-        if rec["status"] != "ok":
-            ax.text2D(0.5, 0.5, "failed:\n" + rec["error"]["type"], ha="center",
-                      transform=ax.transAxes, fontsize=8, color="tab:red")  # fmt: skip
-            continue
-        X = np.asarray(rec["result"]["X"])
-        rigid = rec["result"]["model"] == "rigid"
-        ax.set_title(f"every {prm['spacing']}, kL = {prm['kappa_L']:g}"
-                     + ("" if rigid else " (bar-hinge)"), fontsize=8)  # fmt: skip
-        ax.add_collection3d(Poly3DCollection(_faces_poly(cp, X),
-                                             facecolor="#9ec5e8" if rigid else "#f5c08a",
-                                             edgecolor="k", linewidths=0.2))  # fmt: skip
-        lo, hi = X.min(0), X.max(0)
-        c, r = 0.5 * (lo + hi), 0.5 * float(np.max(hi - lo))
-        ax.set(xlim=(c[0] - r, c[0] + r), ylim=(c[1] - r, c[1] + r), zlim=(c[2] - r, c[2] + r))
-        ax.view_init(elev=25, azim=-60)
-    fig.suptitle(f"{pattern}: actuator spacing (rows) x curvature kappa L (columns)", fontsize=9)
-    fig.savefig(path, dpi=110)
+    kl = s["kappa_L"]
+    fig = plt.figure(figsize=(2.2 * len(kl), 2.0 * len(PATTERNS)), layout="constrained")
+    for i, p in enumerate(PATTERNS):
+        cp = make_pattern(p, quick)
+        for j, k in enumerate(kl):
+            ax = fig.add_subplot(len(PATTERNS), len(kl), i * len(kl) + j + 1, projection="3d")
+            ax.set_axis_off()
+            r = get(ix, pattern=p, spacing=1, kappa_L=k)
+            if r is None:
+                ax.set_title(f"{p} κL={k:g}: failed", fontsize=7)
+                continue
+            X = np.asarray(r["X"])
+            ax.add_collection3d(
+                Poly3DCollection(
+                    [X[list(f)] for f in cp.faces],
+                    facecolor="#9ec5e8",
+                    edgecolor="k",
+                    linewidths=0.2,
+                )
+            )
+            lo, hi = X.min(0), X.max(0)
+            c, h = 0.5 * (lo + hi), 0.5 * float(np.max(hi - lo))
+            ax.set(xlim=(c[0] - h, c[0] + h), ylim=(c[1] - h, c[1] + h), zlim=(c[2] - h, c[2] + h))
+            ax.view_init(elev=25, azim=-60)
+            ax.set_title(
+                f"{p} κL={k:g}\nKL²={_f(r['KL2'], '.2g')}, misfit {r['actuator_misfit_deg']:.2g}°",
+                fontsize=6,
+            )
+    fig.suptitle(f"Rigid-limit forms (spacing 1) — {stamp}", fontsize=8)
+    fig.savefig(path, dpi=100)
     plt.close(fig)
 
 
-def heat_maps(key: str, label: str, path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(2, 3, figsize=(11, 6), layout="constrained")
-    for ax, p in zip(axes.flat, PATTERNS, strict=True):
-        A = RESULTS[p][key]
-        if key in ("K", "KL2"):
-            m = float(np.nanmax(np.abs(A), initial=0.0)) or 1.0
-            im = ax.imshow(A, cmap="coolwarm", vmin=-m, vmax=m, origin="lower")
-        else:
-            im = ax.imshow(A, cmap="viridis", origin="lower")
-        ax.set_xticks(range(len(KAPPA_L)), [f"{k:g}" for k in KAPPA_L])
-        ax.set_yticks(range(len(SPACINGS)), [str(s) for s in SPACINGS])
-        ax.set_xlabel("kappa L")
-        ax.set_ylabel("spacing (crossings)")
-        ax.set_title(p, fontsize=10)
-        for (i, j), v in np.ndenumerate(A):
-            txt = "failed" if np.isnan(v) else ("0" if abs(v) < 1e-9 else f"{v:.2g}")
-            ax.text(j, i, txt, ha="center", va="center",
-                    fontsize=7)  # fmt: skip
-        fig.colorbar(im, ax=ax, shrink=0.8)
-    fig.suptitle(label)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+# ------------------------------------------------------------------------------ docs
+def replace_block(text: str, name: str, content: str) -> str:
+    """Replace the text between ``<!-- BEGIN name -->`` and ``<!-- END name -->``."""
+    pat = re.compile(rf"(<!-- BEGIN {name} -->\n).*?(<!-- END {name} -->)", re.S)
+    if not pat.search(text):
+        raise KeyError(f"docs/transformations.md has no block {name!r}")
+    return pat.sub(lambda m: m.group(1) + content.rstrip() + "\n" + m.group(2), text)
 
 
-if MAIN:
-    img = OUT / "img"
-    img.mkdir(parents=True, exist_ok=True)
-    for p in PATTERNS:
-        picture_grid(p, img / f"forms_{p}.png")
-    heat_maps("KL2", "Gaussian curvature of the global form, K L^2 (L = sheet width)",
-              img / "heat_K.png")  # fmt: skip
-    heat_maps("nonsync_deg", "Spread of fold angles among repeated creases (deg)",
-              img / "heat_nonsync.png")  # fmt: skip
-    if not QUICK:  # the pictures of docs/transformations.md
-        import shutil
+def _describe(prm: dict) -> str:
+    """``pattern kind, key = value, ...`` of a run (for the list of failed runs)."""
+    skip = ("pattern", "kind", "quick", "steps")
+    rest = ", ".join(f"{k} = {v}" for k, v in prm.items() if k not in skip and v is not None)
+    return f"{prm['pattern']} ({prm['kind']}): {rest}"
 
-        docs_img = HERE.parents[1] / "docs" / "img"
-        docs_img.mkdir(parents=True, exist_ok=True)
-        for f in img.glob("*.png"):
-            shutil.copy(f, docs_img / f"transformations_{f.name}")
-    print(f"{'pattern':>17} {'ok':>3} {'rigid':>5} {'b&h':>4} {'failed':>6} "
-          f"{'K L^2 min':>10} {'K L^2 max':>10} {'nonsync max':>11}")  # fmt: skip
-    for p in PATTERNS:
-        recs = [r for r in RECORDS.values() if r["params"]["pattern"] == p]
-        ok = [r["result"] for r in recs if r["status"] == "ok"]
-        kl = [q["KL2"] for q in ok] or [np.nan]
-        ns = [q["nonsync_deg"] for q in ok] or [np.nan]
-        print(f"{p:>17} {len(ok):>3} {sum(q['model'] == 'rigid' for q in ok):>5} "
-              f"{sum(q['model'] == 'bar-hinge' for q in ok):>4} {len(recs) - len(ok):>6} "
-              f"{min(kl):>10.3g} {max(kl):>10.3g} {max(ns):>11.3g}")  # fmt: skip
-    print(f"{REPORT.total} runs ({REPORT.skipped} from before), {len(FAILED)} failed -> {OUT}")
-    for f in FAILED:
-        print(f"  failed: {f[0]:>17} spacing {f[1]} kappa_L {f[2]:>5}: {f[3]['type']}: "
-              f"{f[3]['message'][:150]}")  # fmt: skip
+
+def stamp_text() -> str:
+    import barhinge
+
+    return f"barhinge {barhinge.__version__}, {datetime.date.today().isoformat()}"
+
+
+def publish(records: dict, quick: bool) -> None:
+    s = settings(quick)
+    ix = index(records)
+    stamp = stamp_text()
+    data = {"stamp": stamp, "quick": quick, "runs": headline(records, quick)}
+    if quick:
+        QUICK_JSON.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n")
+        return
+    FULL_JSON.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n")
+    conv = convergence(ix, s)
+    img = ROOT / "docs" / "img"
+    figure_convergence(conv, s, img / "transformations_convergence.png", stamp)
+    figure_forms(ix, s, quick, img / "transformations_forms.png", stamp)
+    n_failed = sum(r["status"] != "ok" for r in records.values())
+    text = DOC.read_text()
+    blocks = {
+        "stamp": f"*Tables and figures below: written by `python studies/transformations/run.py "
+        f"--publish` ({stamp}; {len(records)} runs, {n_failed} failed).*",
+        "rigid": table_rigid(ix, s),
+        "convergence": table_convergence(conv, s),
+        "curves": table_curves(ix, s),
+        "surfaces": table_surfaces(ix, s),
+        "placement": table_placement(placement_rows(ix, s, quick)),
+        "signs": table_signs(ix, records),
+        "design": table_design(ix, s),
+        "failed": "\n".join(
+            f"* {_describe(r['params'])}: {r['error']['type']}: "
+            f"{r['error']['message'].splitlines()[0][:160]}"
+            for r in records.values()
+            if r["status"] != "ok"
+        )
+        or "none",
+    }
+    for name, content in blocks.items():
+        text = replace_block(text, name, content)
+    DOC.write_text(text)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(
+        prog="python studies/transformations/run.py",
+        description="Six tessellations under control curves and surfaces: rigid limit and "
+        "bar-and-hinge model per cell, actuator placement from the DOF analysis. A rerun "
+        "skips finished runs.",
+    )
+    ap.add_argument("--quick", action="store_true", help="small sheets, few cells (what CI checks)")
+    ap.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        help="result folder (default studies/transformations/results[-quick])",
+    )
+    ap.add_argument("--serial", action="store_true", help="run in this process (no Dask)")
+    ap.add_argument("--workers", type=int, default=None, help="local Dask workers")
+    ap.add_argument("--retry-failed", action="store_true", help="rerun the failed runs")
+    ap.add_argument(
+        "--publish",
+        action="store_true",
+        help="write docs/transformations.md tables and figures (full) or "
+        "docs/transformations-quick.json (--quick)",
+    )
+    a = ap.parse_args(argv)
+    out = a.out or HERE / ("results-quick" if a.quick else "results")
+    report, records = run(a.quick, out, a.serial or a.quick, a.workers, a.retry_failed)
+    s = settings(a.quick)
+    ix = index(records)
+    print(
+        table_rigid(ix, s),
+        "",
+        table_convergence(convergence(ix, s), s),
+        "",
+        table_placement(placement_rows(ix, s, a.quick)),
+        "",
+        table_signs(ix, records),
+        "",
+        table_design(ix, s),
+        sep="\n",
+    )
+    failed = [r for r in records.values() if r["status"] != "ok"]
+    print(f"{report.total} runs ({report.skipped} from before), {len(failed)} failed -> {out}")
+    for r in failed:
+        print(f"  failed: {r['params']}: {r['error']['type']}: {r['error']['message'][:150]}")
+    if a.publish:
+        publish(records, a.quick)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,7 +1,15 @@
-"""Point function of the transformations study (imported by the sweep, also on workers).
+"""Point functions of the transformations study (imported by the sweep, also on workers).
 
-See run.py for the study. ``point(pattern, spacing, kappa_L, quick, steps)`` folds one
-pattern and returns a small record.
+See run.py for the study and docs/transformations.md for the results.
+
+* ``point(pattern, spacing, curve, kappa_L, ky_L, model, quick, steps)`` folds one pattern
+  with actuators on a control curve (or, with ``ky_L``, a control surface) with one model:
+  ``model="rigid"`` is the energy-minimising rigid limit (``bh.rigid_fold``, incompatible
+  targets met in least squares), ``model=r`` (a number) the bar-and-hinge model (N5B8) with
+  bars and panel bending ``r`` times the default (``stiffness_ratio``).
+* ``placement_point(pattern, quick, count, placement)`` folds a pattern to a reference rigid
+  form with ``count`` actuators chosen by the DOF analysis (``bh.dof``) or along section
+  lines, and returns the form error.
 """
 
 from __future__ import annotations
@@ -11,13 +19,7 @@ import importlib
 import numpy as np
 
 BASE_DEG = 30.0
-
-
-def _material():
-    from barhinge.model.calibrate import Material
-
-    return Material(E=1e6, nu=0.3, t=0.01)
-
+MATERIAL = {"E": 1e6, "nu": 0.3, "t": 0.01}
 
 # name -> (module of barhinge.patterns, generator, keyword arguments quick, full)
 PATTERNS: dict[str, tuple[str, str, dict, dict]] = {
@@ -34,15 +36,33 @@ PATTERNS: dict[str, tuple[str, str, dict, dict]] = {
     "resch": ("resch", "resch", {"nx": 4, "ny": 4}, {}),
 }
 
+CURVES = ("circle", "parabola", "spline")
+
 
 def make_pattern(name: str, quick: bool):
     """The flat crease pattern of a study pattern (quick or full size)."""
     module, func, kq, kf = PATTERNS[name]
-    try:
-        gen = getattr(importlib.import_module(f"barhinge.patterns.{module}"), func)
-    except (ImportError, AttributeError):
-        raise ImportError(f"barhinge.patterns has no generator {func!r} yet") from None
+    gen = getattr(importlib.import_module(f"barhinge.patterns.{module}"), func)
     return gen(**(kq if quick else kf))
+
+
+def make_curve(curve: str, kappa: float, L: float):
+    """The control curve ``curve`` with curvature ``kappa`` at its apex (x = 0).
+
+    ``circle``: circle of curvature kappa; ``parabola``: ``z = kappa x^2 / 2``; ``spline``: a
+    cubic spline through five points of the lopsided parabola ``z = kappa x^2 (1 + x / L) / 2``
+    (curvature ``kappa`` at the apex, ``2 kappa`` at the +x end, 0 at the -x end).
+    """
+    from barhinge.control import CircularArc, Parabola, SplineCurve
+
+    if curve == "circle":
+        return CircularArc(kappa)
+    if curve == "parabola":
+        return Parabola(kappa)
+    if curve == "spline":
+        xs = np.linspace(-0.5 * L, 0.5 * L, 5)
+        return SplineCurve(xs, 0.5 * kappa * xs * xs * (1.0 + xs / L))
+    raise ValueError(f"curve must be one of {CURVES}, got {curve!r}")
 
 
 def nonsync_deg(cp, rho_deg: np.ndarray) -> float:
@@ -58,7 +78,7 @@ def nonsync_deg(cp, rho_deg: np.ndarray) -> float:
     d = V[cp.edges[E, 1]] - V[cp.edges[E, 0]]
     ang = np.round(np.degrees(np.arctan2(d[:, 1], d[:, 0])) % 180.0).astype(int) % 180
     length = np.round(np.hypot(d[:, 0], d[:, 1]) / (1e-6 * cp.size)).astype(np.int64)
-    keys = {}
+    keys: dict = {}
     for e, a, n, asg in zip(E, ang, length, cp.assignment[E], strict=True):
         keys.setdefault((asg, a, n), []).append(e)
     num = den = 0.0
@@ -69,71 +89,190 @@ def nonsync_deg(cp, rho_deg: np.ndarray) -> float:
     return num / den if den else 0.0
 
 
-def _first_line(exc: BaseException) -> str:
-    lines = str(exc).strip().splitlines()
-    return f"{type(exc).__name__}: {lines[0] if lines else ''}"
-
-
-def fold(cp, acts, steps: int):
-    """Rigid kinematics (planar panels) if it can follow the actuators, else bar-and-hinge.
-
-    Returns (path, model or None, rigid failure reason or None).
-    """
+def _model(cp, ratio: float | None):
     import barhinge as bh
-    from barhinge.errors import BarhingeError
+
+    return bh.BarHingeModel.from_pattern(
+        cp, scheme="N5B8", material=bh.Material(**MATERIAL), stiffness_ratio=ratio
+    )
+
+
+def rigid_weights(cp) -> np.ndarray:
+    """(n_edges,) fold-spring stiffness of the bar-and-hinge model per edge, normalised to a
+    largest crease value of 1 (the rigid limit of that model; the energy minimum does not
+    depend on the scale)."""
+    from barhinge.solve.branch import fold_weights
+
+    w, _ = fold_weights(_model(cp, None))
+    return w / float(w[cp.crease_edges].max())
+
+
+def rigid_limit(cp, acts, steps: int):
+    """The energy-minimising rigid fold (incompatible targets met in least squares)."""
+    import barhinge as bh
     from barhinge.kinematics.path import RigidOptions
 
-    try:
-        # over-determined actuators fail at the first step; 3 cut-backs tell that quickly
-        opts = RigidOptions(check_actuators=False, max_cutbacks=3, over_actuated="error")
-        path = bh.rigid_fold(cp, acts, steps=steps, options=opts)
-        if path.converged:
-            return path, None, None
-        reason = f"not converged: {path.message}"
-    except (BarhingeError, ArithmeticError, RuntimeError, np.linalg.LinAlgError) as exc:
-        reason = _first_line(exc)
-    model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=_material())
-    return bh.solve(bh.Scene(model, actuators=acts, steps=steps)), model, reason
+    opts = RigidOptions(check_actuators=False, over_actuated="least_squares")
+    return bh.rigid_fold(cp, acts, steps=steps, fold_stiffness=rigid_weights(cp), options=opts)
 
 
-def point(pattern: str, spacing: int, kappa_L: float, quick: bool = True, steps: int = 6) -> dict:
-    """Fold one pattern with actuators every ``spacing`` crossings on a circle kappa_L / L."""
+def _targets(cp, spacing: int, curve: str, kappa_L: float, ky_L: float | None):
+    """Actuators of one cell: base fold s_i * BASE_DEG plus the control rotation angles."""
     import barhinge as bh
-    from barhinge.control import CircularArc, curve_angles_deg, section_crossings
+    from barhinge.control import (
+        ControlSurface,
+        curve_angles_deg,
+        section_crossings,
+        surface_actuators,
+    )
+
+    edges, x, ends = section_crossings(cp)
+    L = ends[1] - ends[0]
+    if ky_L is None:
+        pick = np.arange(0, len(edges), int(spacing))
+        edges, x = edges[pick], x[pick]
+        phi = curve_angles_deg(make_curve(curve, kappa_L / L, L), x, ends)
+        d = float(np.mean(np.diff(x))) if len(x) > 1 else None
+    else:
+        ey, _, ends_y = section_crossings(cp, direction=(0.0, 1.0))
+        Ly = ends_y[1] - ends_y[0]
+        ey = ey[~np.isin(ey, edges)]
+        acts = surface_actuators(
+            cp,
+            ControlSurface(kappa_L / L, ky_L / Ly),
+            edges=(edges[:: int(spacing)], ey[:: int(spacing)]),
+        )
+        edges, phi = acts.edges, acts.targets_deg
+        d = None
+    sign = np.where(cp.assignment[edges] == "M", -1.0, 1.0)
+    return bh.Actuators(edges=edges, targets_deg=sign * BASE_DEG + phi), L, d
+
+
+def point(
+    pattern: str,
+    spacing: int = 1,
+    curve: str = "circle",
+    kappa_L: float = 0.0,
+    ky_L: float | None = None,
+    model: str | float = "rigid",
+    quick: bool = True,
+    steps: int = 6,
+) -> dict:
+    """Fold one pattern with one model; returns the global form and how it was reached."""
+    import barhinge as bh
 
     cp = make_pattern(pattern, quick)
-    edges, x, ends = section_crossings(cp)
-    pick = np.arange(0, len(edges), spacing)
-    edges, x = edges[pick], x[pick]
-    L = ends[1] - ends[0]
-    kappa = kappa_L / L
-    phi = curve_angles_deg(CircularArc(kappa), x, ends)
-    sign = np.where(cp.assignment[edges] == "M", -1.0, 1.0)
-    targets = sign * BASE_DEG + phi
-    acts = bh.Actuators(edges=edges, targets_deg=targets)
-    path, model, rigid_error = fold(cp, acts, steps)
+    acts, L, d = _targets(cp, spacing, curve, kappa_L, ky_L)
+    edges, targets = acts.edges, acts.targets_deg
+    if model == "rigid":
+        path = rigid_limit(cp, acts, steps)
+        curv = bh.gaussian_curvature(path, pattern=cp)
+        misfit = path.meta.get("actuator_misfit_deg")
+        label = "rigid limit (energy-minimising)"
+        free = path.meta.get("free_dof")
+    else:
+        m = _model(cp, float(model))
+        path = bh.solve(bh.Scene(m, actuators=acts, steps=steps))
+        curv = bh.gaussian_curvature(path, model=m)
+        misfit = None
+        label = f"bar-and-hinge N5B8, stiffness ratio {float(model):g}"
+        free = None
     rho = path.fold_angles_deg[-1]
-    curv = (
-        bh.gaussian_curvature(path, pattern=cp)
-        if model is None
-        else bh.gaussian_curvature(path, model=model)
-    )
     g = curv.global_fit
     defect = curv.angle_defect if curv.angle_defect is not None else np.zeros(1)
+    act_err = float(np.max(np.abs(rho[edges] - targets)))
     return {
-        "model": "rigid" if model is None else "bar-hinge",
-        "rigid_error": rigid_error,
+        "model": "rigid" if model == "rigid" else "bar-hinge",
+        "model_label": label,
+        "stiffness_ratio": None if model == "rigid" else float(model),
         "n_actuators": len(edges),
-        "d_mean": float(np.mean(np.diff(x))) if len(x) > 1 else float("nan"),
-        "kappa": kappa,
+        "d_mean": d,
         "L": L,
         "K": float(g.K),
         "KL2": float(g.K) * L * L,
-        "k1": float(g.k1),
-        "k2": float(g.k2),
+        "k1L": float(g.k1) * L,
+        "k2L": float(g.k2) * L,
+        "curvature_fit": "one quadratic z(x, y) through the facet centroids",
+        "actuator_misfit_deg": act_err if misfit is None else float(misfit[-1]),
+        "free_dof": free,
         "nonsync_deg": nonsync_deg(cp, rho),
-        "max_fold_deg": float(np.max(np.abs(rho))),
-        "actuator_error_deg": float(np.max(np.abs(rho[edges] - targets))),
         "max_angle_defect_deg": float(np.degrees(np.nanmax(np.abs(defect)))),
+        "rho_deg": np.round(rho[cp.crease_edges], 9),
         "X": np.round(path.X[-1][: cp.n_vertices], 6),
     }
+
+
+# ------------------------------------------------------------------------------ placement
+def section_placement(cp, count: int) -> np.ndarray:
+    """``count`` creases along the two middle section lines: evenly spaced crossings of the
+    line along x, then (beyond its crossings) of the line along y."""
+    from barhinge.control import section_crossings
+
+    ex = section_crossings(cp)[0]
+    ey = section_crossings(cp, direction=(0.0, 1.0))[0]
+    ey = ey[~np.isin(ey, ex)]
+    if count <= len(ex):
+        return ex[np.unique(np.round(np.linspace(0, len(ex) - 1, count)).astype(int))]
+    k = min(count - len(ex), len(ey))
+    return np.concatenate([ex, ey[np.unique(np.round(np.linspace(0, len(ey) - 1, k)).astype(int))]])
+
+
+def reference_form(cp, seed: int = 0, steps: int = 6):
+    """A generic rigid form: the DOF analysis's actuators driven to random angles (20-40 deg
+    with their assignment's sign). Returns (actuators of bh.dof, path)."""
+    import barhinge as bh
+
+    A = np.asarray(bh.dof(cp).mechanism.actuators, dtype=np.int64)
+    rng = np.random.default_rng(seed)
+    sign = np.where(cp.assignment[A] == "M", -1.0, 1.0)
+    acts = bh.Actuators(edges=A, targets_deg=sign * rng.uniform(20.0, 40.0, len(A)))
+    return A, rigid_limit(cp, acts, steps)
+
+
+def placement_point(
+    pattern: str, count: int, placement: str, quick: bool = True, steps: int = 6
+) -> dict:
+    """Fold to the reference form with ``count`` actuators placed by ``placement``.
+
+    ``placement="dof"``: the first ``count`` actuators of ``bh.dof`` (column-pivoted QR order);
+    ``"section"``: :func:`section_placement`. Each actuator is driven to its angle in the
+    reference form; the other creases follow the energy-minimising rigid limit. Form error:
+    the largest fold-angle difference to the reference over all creases.
+    """
+    import barhinge as bh
+
+    cp = make_pattern(pattern, quick)
+    A, ref = reference_form(cp, steps=steps)
+    rho_ref = ref.fold_angles_deg[-1]
+    E = A[:count] if placement == "dof" else section_placement(cp, count)
+    path = rigid_limit(cp, bh.Actuators(edges=E, targets_deg=rho_ref[E]), steps)
+    rho = path.fold_angles_deg[-1]
+    L = float(np.ptp(np.asarray(cp.vertices)[:, 0]))
+    K = bh.gaussian_curvature(path, pattern=cp).global_fit.K
+    K_ref = bh.gaussian_curvature(ref, pattern=cp).global_fit.K
+    return {
+        "model": "rigid",
+        "model_label": "rigid limit (energy-minimising)",
+        "n_dof": len(A),
+        "n_actuators": len(E),
+        "edges": E,
+        "reference_misfit_deg": float(ref.meta.get("actuator_misfit_deg", [0.0])[-1]),
+        "actuator_misfit_deg": float(path.meta.get("actuator_misfit_deg", [0.0])[-1]),
+        "form_error_deg": float(np.max(np.abs(rho - rho_ref)[cp.crease_edges])),
+        "KL2": float(K) * L * L,
+        "KL2_reference": float(K_ref) * L * L,
+    }
+
+
+def cell(kind: str, pattern: str, quick: bool = True, steps: int = 6, **params) -> dict:
+    """One run of the study: ``kind`` is ``"form"`` (:func:`point`), ``"placement"``
+    (:func:`placement_point`) or ``"design"`` (``design.design``, on the quick-size sheets)."""
+    if kind == "form":
+        return point(pattern, quick=quick, steps=steps, **params)
+    if kind == "placement":
+        return placement_point(pattern, quick=quick, steps=steps, **params)
+    if kind == "design":
+        from design import design
+
+        return design(pattern, quick=True, **params)  # always on the small sheets
+    raise ValueError(f"kind must be 'form', 'placement' or 'design', got {kind!r}")

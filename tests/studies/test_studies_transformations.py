@@ -1,0 +1,153 @@
+"""The transformation study (studies/transformations) against its published quick numbers.
+
+docs/transformations-quick.json is written by ``python studies/transformations/run.py --quick
+--publish``; these tests recompute a subset of its runs and check them against it, and check
+the physics the doc states with independent references:
+
+* a rigid Miura-ori sheet is a one-DOF mechanism whose folded form stays globally flat (K = 0)
+  and whose bending under a curved control is a saddle (K < 0) once the panels may strain
+  (Schenk & Guest 2013, PNAS 110:3276, out-of-plane Poisson's ratio positive);
+* the bar-and-hinge model approaches the rigid limit as 1/r in the stiffness ratio r where
+  the targets are compatible (log-log slope -1);
+* the DOF analysis's actuators fix the form at their count (form error 0), section-line
+  creases at the same count do not (Yoshimura: DOF 10).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+HERE = ROOT / "studies" / "transformations"
+PUBLISHED = json.loads((ROOT / "docs" / "transformations-quick.json").read_text())["runs"]
+
+
+@pytest.fixture(scope="module")
+def run_mod():
+    sys.path.insert(0, str(HERE))
+    try:
+        spec = importlib.util.spec_from_file_location("transformations_run", HERE / "run.py")
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)  # defines, runs nothing
+        import transform
+
+        yield mod, transform
+    finally:
+        sys.path.remove(str(HERE))
+
+
+def _published(params: dict) -> dict:
+    return PUBLISHED[json.dumps(params, sort_keys=True)]
+
+
+def _form(pattern, kappa_L, model="rigid", curve="circle", ky_L=None) -> dict:
+    return {"kind": "form", "pattern": pattern, "spacing": 1, "curve": curve,
+            "kappa_L": kappa_L, "ky_L": ky_L, "model": model}  # fmt: skip
+
+
+def _recompute(transform, params: dict) -> dict:
+    prm = {k: v for k, v in params.items() if k != "kind"}
+    return transform.cell(params["kind"], quick=True, steps=6, **prm)
+
+
+def _check(res: dict, pub: dict) -> None:
+    assert res["model_label"] == pub["model_label"]
+    for k in ("KL2", "actuator_misfit_deg", "form_error_deg"):
+        if k in pub:
+            np.testing.assert_allclose(res[k], pub[k], rtol=1e-5, atol=1e-7, err_msg=k)
+
+
+def test_help_runs_nothing(run_mod, capsys) -> None:
+    mod, _ = run_mod
+    with pytest.raises(SystemExit) as exc:
+        mod.main(["--help"])
+    assert exc.value.code == 0
+    assert "--quick" in capsys.readouterr().out
+
+
+def test_quick_run_list_matches_the_published_numbers(run_mod) -> None:
+    mod, _ = run_mod
+    keys = {json.dumps(p, sort_keys=True) for p in mod.runs(quick=True)}
+    assert keys == set(PUBLISHED), "rerun `run.py --quick --publish`"
+    for p in mod.runs(quick=True):  # every cell says which model produced it
+        assert PUBLISHED[json.dumps(p, sort_keys=True)]["model_label"]
+
+
+def test_rerun_skips_finished_runs(run_mod, tmp_path, monkeypatch) -> None:
+    mod, _ = run_mod
+    monkeypatch.setattr(mod, "runs", lambda quick: [_form("miura", 0.0), _form("yoshimura", 1.0)])
+    first, _ = mod.run(True, tmp_path, True, None, False)
+    again, records = mod.run(True, tmp_path, True, None, False)
+    assert (first.skipped, again.skipped, again.total) == (0, 2, 2)
+    assert all(r["status"] == "ok" for r in records.values())
+
+
+def test_bar_and_hinge_converges_to_the_rigid_limit_as_one_over_r(run_mod) -> None:
+    """Compatible targets (yoshimura kappa L = 1, miura kappa L = 0): max fold-angle
+    distance to the rigid limit falls like 1/r (solver.md, rigid limit)."""
+    mod, transform = run_mod
+    for pattern, kl, tol in (("yoshimura", 1.0, 0.05), ("miura", 0.0, 0.15)):
+        rig = _recompute(transform, _form(pattern, kl))
+        _check(rig, _published(_form(pattern, kl)))
+        assert rig["actuator_misfit_deg"] < 1e-6
+        d = []
+        for r in (10.0, 100.0):
+            bh = _recompute(transform, _form(pattern, kl, r))
+            _check(bh, _published(_form(pattern, kl, r)))
+            d.append(np.max(np.abs(np.asarray(bh["rho_deg"]) - rig["rho_deg"])))
+        assert mod.slope([10.0, 100.0], d) == pytest.approx(-1.0, abs=tol)
+
+
+def test_rigid_miura_stays_flat_and_bends_into_a_saddle_only_by_straining(run_mod) -> None:
+    """Curved control of the one-DOF Miura: the rigid limit can only meet the targets in
+    least squares (misfit > 0) and stays globally flat (K = 0); the bar-and-hinge model meets
+    them by straining into a saddle (K < 0, Schenk & Guest 2013)."""
+    _, transform = run_mod
+    rig = _recompute(transform, _form("miura", 1.0))
+    _check(rig, _published(_form("miura", 1.0)))
+    assert rig["actuator_misfit_deg"] > 1.0 and abs(rig["KL2"]) < 1e-9
+    for r in (10.0, 100.0):  # published only (6 s each)
+        assert _published(_form("miura", 1.0, r))["KL2"] < -0.01
+    for kx, ky in ((1.0, 1.0), (1.0, -1.0)):  # no control surface makes a rigid Miura curve
+        assert abs(_published(_form("miura", kx, "rigid", "parabola", ky))["KL2"]) < 1e-9
+
+
+def test_dof_placement_fixes_the_form_and_section_lines_do_not(run_mod) -> None:
+    _, transform = run_mod
+    for placement, fixed in (("dof", True), ("section", False)):
+        p = {"kind": "placement", "pattern": "yoshimura", "count": 10, "placement": placement}
+        res = _recompute(transform, p)
+        _check(res, _published(p))
+        assert (res["form_error_deg"] < 1e-6) == fixed
+
+
+def test_inverse_design_reaches_an_arch_and_says_why_a_miura_cannot_be_a_dome(run_mod) -> None:
+    """miura_arc: the arch k2 L = -0.6 (k1 = 0) is reached by the one bh.dof actuator; a Miura
+    sheet asked for a dome is not, with the reason (its rigid folds are globally flat)."""
+    _, transform = run_mod
+    for pattern, k1, k2, reached in (("miura_arc", 0.0, -0.6, True), ("miura", -0.5, -0.5, False)):
+        p = {"kind": "design", "pattern": pattern, "target_k1L": k1, "target_k2L": k2}
+        res = _recompute(transform, p)
+        _check(res, _published(p))
+        assert res["reached"] is reached
+        assert (res["relative_error"] <= 0.05) is reached
+        if not reached:
+            assert "does not respond to the actuators" in res["reason"]
+    p = {"kind": "design", "pattern": "yoshimura", "target_k1L": 0.2, "target_k2L": -3.0}
+    assert _published(p)["relative_error"] < 0.05  # published only (8 s)
+
+
+def test_every_table_of_the_doc_is_written_and_stamped() -> None:
+    import re
+
+    text = (ROOT / "docs" / "transformations.md").read_text()
+    blocks = re.findall(r"<!-- BEGIN (\w+) -->\n(.*?)<!-- END \1 -->", text, flags=re.S)
+    assert {b for b, _ in blocks} >= {"stamp", "rigid", "convergence", "placement", "design"}
+    assert all(body.strip() for _, body in blocks), "rerun `run.py --publish`"
+    assert re.search(r"barhinge \d+\.\d+\.\d+, \d{4}-\d\d-\d\d", dict(blocks)["stamp"])
