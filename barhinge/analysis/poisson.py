@@ -6,8 +6,16 @@ Definitions (named as such in the results)
   the mean distance of vertex pairs one period apart (e.g. Miura vertices ``(i, j)`` and
   ``(i + 2, j)``: ``2 L``; ``(i, j)`` and ``(i, j + 2)``: ``2 S``). This is the unit-cell ratio
   of Schenk & Guest (2013, PNAS 110(9):3276, Eq. 2), free of boundary effects.
-* ``end-to-end``: the sheet's overall dimensions, the distances between the centroids of two
-  pairs of opposite boundary vertex groups (left/right, bottom/top).
+* ``end-to-end``: the sheet's overall dimensions, the extents between two pairs of opposite
+  boundary vertex groups (left/right, bottom/top): along the line joining the groups'
+  centroids, from the outermost vertex of one end to the outermost vertex of the other (for a
+  flat-ish sheet, its bounding-box size). For a Miura sheet of ``n`` cells this is
+  ``2 n L + V`` along the zig-zag direction, where the periodic length is ``2 L`` (Schenk &
+  Guest 2013, Eq. 1, cell dimensions): the finite-sheet ratio differs from the periodic one
+  and tends to it as ``n`` grows (one cell at ``cos^2(theta) tan^2(gamma) = 1``, where the
+  periodic ratio is -1: about -1/3). ``measure="centroid"`` keeps the distance between the
+  group centroids, which cancels the zig-zag offset and gives the periodic ratio again on a
+  uniform sheet.
 
 Both give the tangent ratio along the path ``nu_21 = -(d ln l_2) / (d ln l_1)``: minus the
 strain in direction 2 per unit strain in direction 1 (direction 1 is the driving one), with the
@@ -128,16 +136,28 @@ def end_to_end_poisson(
     ends_2: tuple[Any, Any],
     *,
     parameter: np.ndarray | None = None,
+    measure: str = "extent",
 ) -> InPlanePoisson:
-    """End-to-end in-plane Poisson's ratio along a path.
+    """End-to-end (finite-sheet) in-plane Poisson's ratio along a path.
 
     Parameters
     ----------
+    path_or_X : FoldPath or (n_states, n_nodes, 3) float
     ends_1, ends_2 : pair of int arrays
         Node groups at the two opposite ends in direction 1 (e.g. left and right boundary
-        vertices) and in direction 2; each length is the distance between group centroids.
+        vertices, :func:`grid_ends`) and in direction 2.
+    parameter : (n_states,) float, optional
+        Path parameter for the derivatives (as in :func:`periodic_poisson`).
+    measure : ``"extent"`` (default) or ``"centroid"``
+        ``"extent"``: the length is the sheet's extent between the two ends, along the unit
+        vector ``u`` from the first group's centroid to the second's:
+        ``max(X_b . u) - min(X_a . u)``. ``"centroid"``: the distance between the group
+        centroids (on a uniform Miura sheet this equals whole periods, so it returns the
+        periodic ratio of :func:`periodic_poisson`, not the sheet's).
     """
     X = _states(path_or_X)
+    if measure not in ("extent", "centroid"):
+        raise ConfigError(f"measure = {measure!r}; expected 'extent' or 'centroid'")
 
     def length(ends: tuple[Any, Any], name: str) -> np.ndarray:
         if len(ends) != 2:
@@ -145,7 +165,16 @@ def end_to_end_poisson(
         a, b = (np.asarray(e, np.int64).ravel() for e in ends)
         if a.size == 0 or b.size == 0 or max(a.max(), b.max()) >= X.shape[1]:
             raise ConfigError(f"{name} groups must be non-empty node ids < {X.shape[1]}")
-        return np.linalg.norm(X[:, b].mean(1) - X[:, a].mean(1), axis=1)
+        d = X[:, b].mean(1) - X[:, a].mean(1)  # (n_states, 3)
+        dist = np.linalg.norm(d, axis=1)
+        if measure == "centroid":
+            return dist
+        if not (dist > 0).all():
+            raise ConfigError(f"{name}: the two end groups have the same centroid")
+        u = d / dist[:, None]
+        pb = np.einsum("sni,si->sn", X[:, b], u).max(axis=1)
+        pa = np.einsum("sni,si->sn", X[:, a], u).min(axis=1)
+        return pb - pa
 
     return _ratio("end-to-end", length(ends_1, "ends_1"), length(ends_2, "ends_2"), parameter)
 

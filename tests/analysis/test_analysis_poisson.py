@@ -48,18 +48,68 @@ def test_miura_periodic_in_plane_ratio_matches_schenk_guest(alpha):
     assert g.nu_SL == pytest.approx(_closed_form(37.0, alpha), rel=1e-12)
 
 
-def test_miura_end_to_end_equals_periodic_for_a_uniform_sheet():
-    """A uniformly folded Miura sheet has no boundary effects: boundary-group centroids are
-    whole periods apart, so both definitions agree to round-off."""
+def _schenk_guest_dims(theta_rad, alpha_deg, a=1.0, b=1.0):
+    """Cell dimensions S, L, V of Schenk & Guest (2013), Eq. 1 (complex-safe)."""
+    g = np.radians(alpha_deg)
+    D = np.sqrt(1.0 + np.cos(theta_rad) ** 2 * np.tan(g) ** 2)
+    S = b * np.cos(theta_rad) * np.tan(g) / D
+    L = a * np.sqrt(1.0 - np.sin(theta_rad) ** 2 * np.sin(g) ** 2)
+    return S, L, b / D
+
+
+def _finite_sheet_nu(theta_deg, alpha_deg, n):
+    """Closed form of a Miura sheet of n cells along x: overall dimensions 2 n L + V (the
+    zig-zag offset V of alternate rows adds once) and 2 n S, Schenk & Guest (2013) Eq. 1;
+    nu = -(d ln(2 n L + V)) / (d ln S), derivatives by complex step (exact to round-off)."""
+    h = 1e-30
+    S, L, V = _schenk_guest_dims(np.radians(theta_deg) + 1j * h, alpha_deg)
+    return -(np.imag(np.log(2 * n * L + V)) / h) / (np.imag(np.log(S)) / h)
+
+
+@pytest.mark.parametrize("n", [1, 3, 5])
+def test_miura_end_to_end_and_periodic_against_schenk_guest(n):
+    """An n x n-cell Miura sheet (gamma = 60 deg) around the facet angle where the periodic
+    ratio is -1 (cos^2 theta tan^2 gamma = 1). Periodic: -cos^2 theta tan^2 gamma (S&G Eq. 2).
+    End-to-end (extents between the end edges): the finite-sheet closed form above, -1/3 for
+    one cell. Tolerance: second-order central differences with d theta = 0.01 deg, error
+    ~ (d theta)^2 ~ 3e-8 relative; 1e-6."""
+    alpha = 60.0
+    th0 = np.degrees(np.arccos(1.0 / np.tan(np.radians(alpha))))  # periodic nu = -1
+    theta = th0 + np.array([-0.01, 0.0, 0.01])
+    X = np.array([patterns.miura(n, n, alpha=alpha, fold=t).vertices3d for t in theta])
+    cp = patterns.miura(n, n, alpha=alpha, fold=th0)
+    px, py = grid_pairs(cp)
+    (left, right), (bottom, top) = grid_ends(cp)
+    per = periodic_poisson(X, py, px)  # drive S (y), measure L (x)
+    e2e = end_to_end_poisson(X, (bottom, top), (left, right))
+    assert e2e.definition == "end-to-end"
+    assert per.nu[1] == pytest.approx(_closed_form(th0, alpha), abs=1e-6)
+    assert per.nu[1] == pytest.approx(-1.0, abs=1e-6)
+    assert e2e.nu[1] == pytest.approx(_finite_sheet_nu(th0, alpha, n), abs=1e-6)
+    if n == 1:
+        assert e2e.nu[1] == pytest.approx(-1.0 / 3.0, abs=1e-6)
+    # the finite-sheet value tends to the periodic one as the sheet grows
+    assert abs(e2e.nu[1] + 1.0) < abs(_finite_sheet_nu(th0, alpha, max(n - 2, 1)) + 1.0) or n == 1
+    # the extent is the sheet's size: 2 n L + V by 2 n S
+    S, L, V = _schenk_guest_dims(np.radians(th0), alpha)
+    assert e2e.length_2[1] == pytest.approx(2 * n * L + V, rel=1e-12)
+    assert e2e.length_1[1] == pytest.approx(2 * n * S, rel=1e-12)
+    # the centroid measure cancels the zig-zag offset: the periodic ratio again
+    cen = end_to_end_poisson(X, (bottom, top), (left, right), measure="centroid")
+    assert cen.nu[1] == pytest.approx(per.nu[1], abs=1e-9)
+
+
+def test_miura_periodic_and_centroid_measures_agree_along_a_path():
     theta, X, cp = _miura_path(12)
     px, py = grid_pairs(cp)
     (left, right), (bottom, top) = grid_ends(cp)
     per = periodic_poisson(X, py, px)
-    e2e = end_to_end_poisson(X, (bottom, top), (left, right))
-    assert e2e.definition == "end-to-end"
-    np.testing.assert_allclose(e2e.nu, per.nu, rtol=0, atol=1e-9)
+    cen = end_to_end_poisson(X, (bottom, top), (left, right), measure="centroid")
+    np.testing.assert_allclose(cen.nu, per.nu, rtol=0, atol=1e-9)
     # S and L both shrink as the sheet folds: the strains have the same sign (auxetic)
     assert np.all(per.strain_1[1:] < 0) and np.all(per.strain_2[1:] < 0)
+    with pytest.raises(ConfigError, match="measure"):
+        end_to_end_poisson(X, (bottom, top), (left, right), measure="bbox")
 
 
 def test_bending_ratio_of_analytic_surfaces():
