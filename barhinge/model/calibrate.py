@@ -21,8 +21,12 @@ Sources
   matches the plane-stress membrane ``t Area C / E``. Six entries, generally more or fewer
   bars: solved in the least-squares sense (minimum norm, non-negative areas). ``"filipov"``
   drops the shear-shear entry (so the rectangle reproduces F17 exactly, shear stiffness
-  ``2 nu / (1 - nu)`` of the membrane's); ``"fit"`` keeps all six entries with equal weight
-  (the improvement documented in docs/calibration.md).
+  ``2 nu / (1 - nu)`` of the membrane's); ``"fit"`` keeps all six entries with equal weight;
+  ``"dilation"`` is ``"fit"`` with the uniform-dilation energy ``eps = I`` imposed (a seventh
+  row, ``C11 + C22 + 2 C12``, weighted ``DILATION_WEIGHT``: exact to ~1e-8 relative), so that
+  every panel shape stores the right energy under a uniform in-plane expansion (thermal or
+  swelling loads) and the rest is spread by least squares. The evidence for the default is
+  the table of docs/calibration.md (``scripts/calibration_table.py``).
 """
 
 from __future__ import annotations
@@ -41,6 +45,7 @@ from barhinge.pattern.crease import CreasePattern
 logger = logging.getLogger(__name__)
 
 __all__ = [
+    "BAR_CALIBRATIONS",
     "BEND_COEFFICIENT_F17",
     "DEFAULT_LSTAR_OVER_T",
     "bar_areas",
@@ -57,6 +62,11 @@ BEND_COEFFICIENT_F17 = 0.55
 #: lower bound of a bar area in the fit, as a fraction of t * face area / total bar length
 #: (keeps every bar load-bearing, so no in-plane mechanism appears; see docs/calibration.md)
 MIN_AREA_FRACTION = 0.1
+#: weight of the dilation row of the ``"dilation"`` bar calibration (relative to the six
+#: moduli rows): the row's residual is ~ 1/weight^2 of the others'
+DILATION_WEIGHT = 1.0e4
+#: bar calibration rules (docs/calibration.md)
+BAR_CALIBRATIONS = ("fit", "filipov", "dilation")
 #: default crease length scale L* / t when neither fold_stiffness nor L* is given.
 DEFAULT_LSTAR_OVER_T = 100.0
 
@@ -201,11 +211,14 @@ def bar_areas(
 ) -> np.ndarray:
     """(n_bars,) cross-section areas by face-wise membrane energy matching (module doc).
 
-    ``method``: ``"fit"`` (all six entries) or ``"filipov"`` (shear-shear entry dropped,
-    F17's closed form for rectangles). A bar shared by two faces sums both contributions.
+    ``method``: ``"fit"`` (all six entries), ``"filipov"`` (shear-shear entry dropped,
+    F17's closed form for rectangles) or ``"dilation"`` (``"fit"`` with the dilation energy
+    imposed). A bar shared by two faces sums both contributions.
     """
-    if method not in ("fit", "filipov"):
-        raise ConfigError(f"bar calibration {method!r} is unknown; expected 'fit' or 'filipov'")
+    if method not in BAR_CALIBRATIONS:
+        raise ConfigError(
+            f"bar calibration {method!r} is unknown; expected one of {BAR_CALIBRATIONS}"
+        )
     X = tri.X0
     pairs = topo.bar_face_pairs  # (bar, face) sorted by bar then face
     order = np.lexsort((pairs[:, 0], pairs[:, 1]))
@@ -232,6 +245,11 @@ def bar_areas(
         e1, e2, A = face_frames(X, faces, fids)
         G = membrane_fit_matrices(X, topo.bars[bar_ids], e1, e2) * row_w[None, :, None]
         y = (A[:, None] * y_unit[None, :]) * row_w[None, :]
+        if method == "dilation":
+            # eps = I: energy row C11 + C22 + 2 C12 (row 3 holds sqrt2 C12)
+            dil = np.array([1.0, 1.0, 0.0, np.sqrt(2.0), 0.0, 0.0]) * DILATION_WEIGHT
+            G = np.concatenate([G, np.einsum("r,nrm->nm", dil, G)[:, None, :]], axis=1)
+            y = np.concatenate([y, (y @ dil)[:, None]], axis=1)
         sol = np.einsum("nmr,nr->nm", np.linalg.pinv(G), y)
         a_min = MIN_AREA_FRACTION * material.t * A / topo_lengths(X, topo.bars[bar_ids])
         bad = np.flatnonzero((sol < a_min[:, None]).any(axis=1))

@@ -224,8 +224,10 @@ def panel_corner_stiffness(model, corners: np.ndarray) -> np.ndarray:
 
 #: homogeneous in-plane strain modes (eps_xx, eps_yy, eps_xy) of the comparison
 def strain_modes(nu: float) -> dict[str, np.ndarray]:
-    """Uniaxial stress along x and y and pure shear, as 2x2 strain tensors."""
+    """Uniform dilation, uniaxial stress along x and y and pure shear, as 2x2 strain
+    tensors."""
     return {
+        "dilation": np.eye(2),
         "uniaxial_x": np.array([[1.0, 0.0], [0.0, -nu]]),
         "uniaxial_y": np.array([[-nu, 0.0], [0.0, 1.0]]),
         "shear": np.array([[0.0, 1.0], [1.0, 0.0]]),

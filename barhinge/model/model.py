@@ -30,6 +30,7 @@ from barhinge.kernels.geometry import (
 )
 from barhinge.kernels.laws import bar_linear, hinge_linear, hinge_penetration
 from barhinge.model.calibrate import (
+    BAR_CALIBRATIONS,
     BEND_COEFFICIENT_F17,
     bar_areas,
     bend_stiffness,
@@ -182,7 +183,9 @@ class BarHingeModel:
             limit studies).
         fold_law : ``"linear"`` or ``"penetration"`` (Liu & Paulino 2017) with
             ``fold_limits_deg``.
-        bar_calibration : ``"fit"`` (default, all membrane moduli) or ``"filipov"``.
+        bar_calibration : ``"fit"`` (default, all membrane moduli), ``"filipov"`` (F17) or
+            ``"dilation"`` (``"fit"`` with the uniform-dilation energy exact); the errors of
+            each against a plane-stress membrane are tabulated in docs/calibration.md.
         bend_coefficient : ``C_B`` of the Filipov bending stiffness.
         bend_calibration : ``"filipov"`` (default, ``C_B D (D_L/t)^(1/3)``) or
             ``"kirchhoff"`` (``2 D (1 - nu) A / D_L^2``, exact twisting of a rectangular
@@ -197,7 +200,7 @@ class BarHingeModel:
         _check.choice(scheme, "scheme", SCHEMES)
         _check.choice(fold_law, "fold_law", FOLD_LAWS)
         _check.choice(strain, "strain", ("green", "engineering"))
-        _check.choice(bar_calibration, "bar_calibration", ("fit", "filipov"))
+        _check.choice(bar_calibration, "bar_calibration", BAR_CALIBRATIONS)
         _check.choice(bend_calibration, "bend_calibration", ("filipov", "kirchhoff", "plate"))
         lim = _check.float_array(fold_limits_deg, "fold_limits_deg", (2,))
         lo, hi = float(lim[0]), float(lim[1])
