@@ -418,11 +418,14 @@ def dof(
     t.add_row("counted DOF (Tachi 2010)", *[str(r.counted_dof) for r in reps])
     t.add_row("DOF from rank", *[f"{r.global_dof} (rank {r.rank}, {r.method})" for r in reps])
     t.add_row("redundant constraints", *[str(r.redundant) for r in reps])
-    t.add_row("σ counted zero / cut / σ non-zero",
-              *[f"{r.sigma_below:.1e} / {r.tolerance:.1e} / {r.sigma_gap:.1e}" for r in reps])  # fmt: skip
-    t.add_row("gap ratio",
-              *[f"{r.gap_ratio:.1e} " + ("certain" if r.certain else
-                f"UNCERTAIN: DOF between {r.dof_range[0]} and {r.dof_range[1]}") for r in reps])  # fmt: skip
+    def doubt(r) -> str:
+        if r.certain:
+            return f"{r.gap_ratio:.1e} certain"
+        return f"{r.gap_ratio:.1e} UNCERTAIN: DOF between {r.dof_range[0]} and {r.dof_range[1]}"
+
+    sig = [f"{r.sigma_below:.1e} / {r.tolerance:.1e} / {r.sigma_gap:.1e}" for r in reps]
+    t.add_row("σ counted zero / cut / σ non-zero", *sig)
+    t.add_row("gap ratio", *[doubt(r) for r in reps])
 
     def hist(a) -> str:
         import numpy as np

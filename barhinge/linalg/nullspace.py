@@ -47,7 +47,7 @@ SPARSE_TOL = 1e-6
 #: a rank cut whose gap ratio is below this is reported as uncertain
 GAP_CERTAIN = 1e3
 #: noise floor of the singular values below the cut, relative to sigma_max (dense, sparse)
-_FLOOR = {"svd": 1e-14, "sparse-inertia": 1e-10}
+_FLOOR = {"svd": 1e-14, "sparse-inertia": 1e-8}  # sparse: sqrt(eps), JᵀJ squares
 #: extra vectors of the block iteration beyond the nullity (singular values above the cut)
 _EXTRA = 8
 
@@ -72,7 +72,8 @@ class NullSpace:
         Largest singular value counted as zero (0.0 if none).
     gap_ratio : float
         ``sigma_gap / max(sigma_below, floor)`` with ``floor`` the method's noise level
-        (1e-14 sigma_max dense, 1e-10 sparse); inf if one side of the cut is empty.
+        (1e-14 sigma_max dense, 1e-8 sparse: ``JᵀJ`` cannot separate singular values below
+        sqrt(eps) sigma_max); inf if one side of the cut is empty.
     certain : bool
         ``gap_ratio >= GAP_CERTAIN``.
     rank_candidates : (int, int)
@@ -124,31 +125,37 @@ def null_space(
     except RankError:
         raise
     except (np.linalg.LinAlgError, RuntimeError, ValueError, MemoryError) as exc:
-        raise RankError(f"rank of the {m} x {n} Jacobian failed: {type(exc).__name__}: {exc}") from exc
+        msg = f"rank of the {m} x {n} Jacobian failed: {type(exc).__name__}: {exc}"
+        raise RankError(msg) from exc
 
 
 def _judge(
     s: np.ndarray, nz: int, smax: float, method: str, gap_certain: float, n: int
 ) -> tuple[float, float, float, bool, tuple[int, int]]:
     """sigma_gap, sigma_below, gap ratio, certainty and rank candidates from the ascending
-    singular values ``s`` nearest the cut of which the first ``nz`` count as zero."""
+    singular values ``s`` nearest the cut, of which the first ``nz`` count as zero.
+
+    The ratio of a cut after ``j`` values is ``s[j] / max(s[j-1], floor)``; values at or
+    below the floor are zero for certain. An uncertain cut gives the range between the
+    nearest clear cuts (ratio >= ``gap_certain``) on either side, or the ends of the
+    computed values (the rank is then at least / at most that)."""
     floor = _FLOOR[method] * max(smax, 1e-300)
     below = float(s[nz - 1]) if nz > 0 else 0.0
     gap = float(s[nz]) if nz < len(s) else np.nan
-    ratio = gap / max(below, floor) if (nz > 0 and nz < len(s)) else np.inf
-    if nz == 0 and nz < len(s):
-        ratio = gap / floor
-    certain = bool(ratio >= gap_certain)
-    rank = n - nz
-    if certain or len(s) < 2:
-        return gap, below, float(ratio), certain, (rank, rank)
-    r = s[1:] / np.maximum(s[:-1], floor)
-    r[nz - 1 if nz > 0 else 0] = 0.0 if nz > 0 else r[0]
-    j = int(np.argmax(r)) + 1  # alternative nullity: cut after j values
-    if nz == 0:
-        j = 0 if s[0] / floor >= r.max() else j
-    alt = n - j
-    return gap, below, float(ratio), certain, (min(rank, alt), max(rank, alt))
+
+    def ratio(j: int) -> float:
+        if j >= len(s):
+            return np.inf
+        return float(s[j] / max(s[j - 1] if j > 0 else 0.0, floor))
+
+    r = ratio(nz)
+    certain = bool(r >= gap_certain)
+    if certain:
+        return gap, below, r, certain, (n - nz, n - nz)
+    j_min = int(np.sum(s <= floor))
+    j_hi = next((j for j in range(nz - 1, j_min - 1, -1) if ratio(j) >= gap_certain), j_min)
+    j_lo = next((j for j in range(nz + 1, len(s) + 1) if ratio(j) >= gap_certain), len(s))
+    return gap, below, r, certain, (n - j_lo, n - j_hi)
 
 
 def _dense(J, tol: float | None, gap_certain: float) -> NullSpace:
@@ -247,24 +254,24 @@ def _sparse(J: sp.csr_matrix, tol: float | None, gap_certain: float) -> NullSpac
     X = np.linalg.qr(rng.standard_normal((n, b)))[0]
     theta = np.zeros(b)
     resid = np.inf
-    for it in range(60):
-        Y = inert.factor.solve(X)
-        Y = np.asarray(Y).reshape(n, b)
+    prev = np.full(b, np.inf)
+    for it in range(80):
+        Y = np.asarray(inert.factor.solve(X)).reshape(n, b)
         Q = np.linalg.qr(Y)[0]
         NQ = N @ Q
         H = Q.T @ NQ
         theta, W = np.linalg.eigh(0.5 * (H + H.T))
         X = Q @ W
-        if nz == 0:
-            if it >= 8:
-                break
-            continue
-        R = NQ @ W[:, :nz] - X[:, :nz] * theta[:nz]
-        resid = float(np.abs(R).max())
-        if resid <= 1e-3 * tau2 and it >= 3:
-            # null vectors converged; a few more sharpen the values above the cut
-            if it >= 8:
-                break
+        if nz:
+            R = NQ @ W[:, :nz] - X[:, :nz] * theta[:nz]
+            resid = float(np.abs(R).max())
+        # stop when the null vectors are converged and the smallest values above the cut
+        # (the gap) have settled to 1e-4
+        above = slice(nz, min(b, nz + 2))
+        settled = np.all(np.abs(theta[above] - prev[above]) <= 1e-4 * np.abs(theta[above]))
+        if resid <= 1e-3 * tau2 and settled and it >= 2:
+            break
+        prev = theta.copy()
     sig = np.linalg.norm(J @ X, axis=0)  # Rayleigh quotients of J: accurate below the cut
     order = np.argsort(sig)
     sig, X = sig[order], X[:, order]
