@@ -117,7 +117,7 @@ def pattern_info(cp, findings_list) -> dict:
         "n_boundary_vertices": int(len(cp.boundary_vertices)),
         "degree_histogram": {int(v): int(c) for v, c in zip(values, counts, strict=True)},
         "dimension": int(V.shape[1]),
-        "flat": bool(cp.is_flat),
+        "flat": bool(cp.is_planar),
         "bounding_box": {
             "min": V.min(0).tolist() if len(V) else [],
             "max": V.max(0).tolist() if len(V) else [],
