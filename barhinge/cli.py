@@ -418,6 +418,7 @@ def dof(
     t.add_row("counted DOF (Tachi 2010)", *[str(r.counted_dof) for r in reps])
     t.add_row("DOF from rank", *[f"{r.global_dof} (rank {r.rank}, {r.method})" for r in reps])
     t.add_row("redundant constraints", *[str(r.redundant) for r in reps])
+
     def doubt(r) -> str:
         if r.certain:
             return f"{r.gap_ratio:.1e} certain"
