@@ -117,7 +117,7 @@ def pattern_info(cp, findings_list) -> dict:
         "n_boundary_vertices": int(len(cp.boundary_vertices)),
         "degree_histogram": {int(v): int(c) for v, c in zip(values, counts, strict=True)},
         "dimension": int(V.shape[1]),
-        "flat": bool(cp.is_flat),
+        "flat": bool(cp.is_planar),
         "bounding_box": {
             "min": V.min(0).tolist() if len(V) else [],
             "max": V.max(0).tolist() if len(V) else [],
@@ -418,8 +418,15 @@ def dof(
     t.add_row("counted DOF (Tachi 2010)", *[str(r.counted_dof) for r in reps])
     t.add_row("DOF from rank", *[f"{r.global_dof} (rank {r.rank}, {r.method})" for r in reps])
     t.add_row("redundant constraints", *[str(r.redundant) for r in reps])
-    t.add_row("smallest non-zero σ / zero threshold",
-              *[f"{r.sigma_gap:.2e} / {r.tolerance:.1e}" for r in reps])  # fmt: skip
+
+    def doubt(r) -> str:
+        if r.certain:
+            return f"{r.gap_ratio:.1e} certain"
+        return f"{r.gap_ratio:.1e} UNCERTAIN: DOF between {r.dof_range[0]} and {r.dof_range[1]}"
+
+    sig = [f"{r.sigma_below:.1e} / {r.tolerance:.1e} / {r.sigma_gap:.1e}" for r in reps]
+    t.add_row("σ counted zero / cut / σ non-zero", *sig)
+    t.add_row("gap ratio", *[doubt(r) for r in reps])
 
     def hist(a) -> str:
         import numpy as np

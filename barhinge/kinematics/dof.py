@@ -33,7 +33,7 @@ import scipy.sparse as sp
 
 from barhinge.errors import ConfigError, PatternError
 from barhinge.kinematics.constraints import RigidConstraints
-from barhinge.linalg.nullspace import DENSE_LIMIT, NullSpace, null_space
+from barhinge.linalg.nullspace import DENSE_LIMIT, NullSpace, RankError, null_space
 from barhinge.pattern.crease import CreasePattern
 
 __all__ = ["DofReport", "dof", "select_actuators", "folded_sample"]
@@ -64,7 +64,16 @@ class DofReport:
         Smallest singular value counted as non-zero (compare with ``tolerance`` to judge how
         clear-cut the rank is; NaN if unknown).
     method : str
-        ``"svd"`` (dense) or ``"sparse-eigsh"``.
+        ``"svd"`` (dense) or ``"sparse-inertia"`` (inertia of ``JᵀJ − τ²I``).
+    sigma_below : float
+        Largest singular value counted as zero (0.0 if none).
+    gap_ratio : float
+        ``sigma_gap / sigma_below`` (the latter floored at the method's noise level, see
+        :mod:`barhinge.linalg.nullspace`): how clear-cut the rank is.
+    certain : bool
+        ``gap_ratio >= 1e3``; else the DOF is only known to lie in ``dof_range``.
+    dof_range : (int, int)
+        Smallest and largest plausible DOF (equal when ``certain``).
     n_variables, n_equations, n_interior_vertices : int
     flat : bool
         True when the state is flat (first-order DOF overestimates the finite DOF).
@@ -104,6 +113,10 @@ class DofReport:
     closure: float
     folded: DofReport | None = None
     note: str = ""
+    sigma_below: float = 0.0
+    gap_ratio: float = float("inf")
+    certain: bool = True
+    dof_range: tuple[int, int] = (0, 0)
     fold_angles_deg: np.ndarray | None = None
 
     @property
@@ -126,6 +139,10 @@ class DofReport:
                 "tolerance": r.tolerance,
                 "sigma_gap": r.sigma_gap,
                 "method": r.method,
+                "sigma_below": r.sigma_below,
+                "gap_ratio": r.gap_ratio if np.isfinite(r.gap_ratio) else None,
+                "certain": r.certain,
+                "dof_range": list(r.dof_range),
                 "n_variables": r.n_variables,
                 "n_equations": r.n_equations,
                 "n_interior_vertices": r.n_interior_vertices,
@@ -271,6 +288,13 @@ def _report(rc: RigidConstraints, rho: np.ndarray, *, prefer: Any, tol: float | 
             f"the state does not close (max |F - I| = {closure:.2e}): the rank is that of the "
             "linearisation at a non-rigid state"
         )
+    lo, hi = (rc.n_var - ns.rank_candidates[1], rc.n_var - ns.rank_candidates[0])
+    if not ns.certain:
+        note = _join(
+            note,
+            f"uncertain rank: gap ratio {ns.gap_ratio:.1e} < 1e3 at the cut (σ {ns.sigma_below:.2e}"
+            f" counted zero, {ns.sigma_gap:.2e} non-zero); the DOF is between {lo} and {hi}",
+        )
     if len(acts) < g:
         note = _join(
             note,
@@ -296,6 +320,10 @@ def _report(rc: RigidConstraints, rho: np.ndarray, *, prefer: Any, tol: float | 
         closure=closure,
         note=note,
         fold_angles_deg=rc.angles_of_edges(rho),
+        sigma_below=ns.sigma_below,
+        gap_ratio=ns.gap_ratio,
+        certain=ns.certain,
+        dof_range=(int(lo), int(hi)),
     )
 
 
@@ -500,6 +528,11 @@ def folded_sample(
     free = np.ones(rc.n_var, bool)
     free[hold] = False
     err = np.inf
+    backend = None
+    if rc.n_var > DENSE_LIMIT:
+        from barhinge.linalg.backends import get_backend
+
+        backend = get_backend("auto")
     for fix in (True, False):
         rho = rho0.copy()
         cols = np.flatnonzero(free) if fix else np.arange(rc.n_var)
@@ -507,7 +540,7 @@ def folded_sample(
             r, J = rc.evaluate(rho)
             if np.max(np.abs(r), initial=0.0) < 1e-13:
                 break
-            rho[cols] += _min_norm_step(J[:, cols], -r)
+            rho[cols] += _min_norm_step(J[:, cols], -r, backend)
         err = float(rc.closure_error(rho).max()) if len(rc.vertices) else 0.0
         if err <= 1e-9 and np.max(np.abs(rho)) >= 1e-3 * magnitude:
             return rho
@@ -521,11 +554,22 @@ def folded_sample(
     )
 
 
-def _min_norm_step(J: sp.csr_matrix, b: np.ndarray) -> np.ndarray:
-    """Minimum-norm least-squares solution of ``J x = b``."""
+def _min_norm_step(J: sp.csr_matrix, b: np.ndarray, backend: Any = None) -> np.ndarray:
+    """Minimum-norm least-squares solution of ``J x = b``: dense ``gelsd`` for small ``J``,
+    else ``(JᵀJ + μI) x = Jᵀb`` with ``μ = 1e-12 ‖JᵀJ‖₁`` by one sparse factorisation (the
+    damping keeps ``x`` out of the null space of a rank-deficient ``J``; a Krylov
+    least-squares solver needed 10⁴–10⁵ iterations on real patterns)."""
     m, n = J.shape
     if n <= DENSE_LIMIT:
         return sla.lstsq(J.toarray(), b, cond=1e-9, lapack_driver="gelsd")[0]
-    import scipy.sparse.linalg as spla
+    from barhinge.linalg.backends import get_backend
 
-    return spla.lsmr(J, b, atol=1e-14, btol=1e-14, maxiter=20 * n)[0]
+    J = sp.csr_matrix(J)
+    N = (J.T @ J).tocsr()
+    mu = 1e-12 * max(float(abs(N).sum(axis=0).max()), 1e-300)
+    A = (N + mu * sp.identity(n, format="csr")).tocsr()
+    try:
+        fac = (backend or get_backend("auto")).factorize(A)
+        return np.asarray(fac.solve(J.T @ b)).ravel()
+    except Exception as exc:  # a failing library must not leave a traceback
+        raise RankError(f"least-squares step of the folded-state projection failed: {exc}") from exc

@@ -1,22 +1,59 @@
-"""Rank and null space of sparse constraint Jacobians (dense SVD or sparse shift-invert)."""
+"""Rank and null space of sparse constraint Jacobians, with the doubt of the rank stated.
+
+* Small matrices: dense SVD.
+* Large sparse matrices: the nullity is the **inertia** of ``JᵀJ − τ²I`` (one sparse
+  symmetric indefinite LDLᵀ, PARDISO or SuperLU in symmetric mode): by Sylvester's law of
+  inertia its negative pivots count the singular values of ``J`` below τ. The null vectors
+  and the singular values on both sides of the cut come from block shift-invert (subspace)
+  iteration on the same factorisation followed by Rayleigh-Ritz (the eigenvalues of ``JᵀJ``
+  nearest τ² dominate). No ARPACK: nothing here can fail to converge silently; a failure of a
+  numerical library becomes a :class:`RankError` (a ``ConvergenceError``: CLI exit code 3).
+
+The cut is clear-cut when the gap ratio ``σ_above / σ_below`` (smallest singular value
+counted non-zero over largest counted zero, the latter floored at the method's noise level) is
+at least ``GAP_CERTAIN``; below that the report gives the two candidate ranks.
+"""
 
 from __future__ import annotations
 
 import dataclasses
+import logging
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
-__all__ = ["NullSpace", "null_space", "DENSE_LIMIT", "DENSE_TOL", "SPARSE_TOL"]
+from barhinge.errors import ConvergenceError
+
+__all__ = [
+    "NullSpace",
+    "RankError",
+    "null_space",
+    "DENSE_LIMIT",
+    "DENSE_TOL",
+    "SPARSE_TOL",
+    "GAP_CERTAIN",
+]
+
+log = logging.getLogger(__name__)
 
 #: above this many columns the sparse method is used
 DENSE_LIMIT = 600
 #: singular values below DENSE_TOL * sigma_max count as zero (dense SVD)
 DENSE_TOL = 1e-8
-#: singular values below SPARSE_TOL * sigma_max count as zero (eigenvalues of J^T J)
+#: singular values below SPARSE_TOL * sigma_max count as zero (inertia of J^T J - tau^2 I;
+#: coarser because J^T J squares the singular values and loses half the digits)
 SPARSE_TOL = 1e-6
+#: a rank cut whose gap ratio is below this is reported as uncertain
+GAP_CERTAIN = 1e3
+#: noise floor of the singular values below the cut, relative to sigma_max (dense, sparse)
+_FLOOR = {"svd": 1e-14, "sparse-inertia": 1e-8}  # sparse: sqrt(eps), JᵀJ squares
+#: extra vectors of the block iteration beyond the nullity (singular values above the cut)
+_EXTRA = 8
+
+
+class RankError(ConvergenceError):
+    """The rank could not be determined (a factorisation or iteration failed)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -27,10 +64,23 @@ class NullSpace:
     ----------
     rank : int
     basis : (n, n - rank) float, orthonormal columns spanning the null space.
-    tolerance : float, absolute threshold on singular values.
+    tolerance : float, absolute threshold on singular values (the cut).
     sigma_max : float, largest singular value (estimate for the sparse method).
-    sigma_gap : float, smallest singular value counted as non-zero (nan if unknown).
-    method : "svd" or "sparse-eigsh".
+    sigma_gap : float, smallest singular value counted as non-zero (nan if none).
+    method : "svd" or "sparse-inertia".
+    sigma_below : float
+        Largest singular value counted as zero (0.0 if none).
+    gap_ratio : float
+        ``sigma_gap / max(sigma_below, floor)`` with ``floor`` the method's noise level
+        (1e-14 sigma_max dense, 1e-8 sparse: ``JᵀJ`` cannot separate singular values below
+        sqrt(eps) sigma_max); inf if one side of the cut is empty.
+    certain : bool
+        ``gap_ratio >= GAP_CERTAIN``.
+    rank_candidates : (int, int)
+        Smallest and largest plausible rank: ``(rank, rank)`` when certain; else this cut and
+        the cut at the largest gap ratio among the computed singular values.
+    sigmas : (k,) float
+        The computed singular values nearest the cut, ascending (all of them dense).
     """
 
     rank: int
@@ -39,53 +89,200 @@ class NullSpace:
     sigma_max: float
     sigma_gap: float
     method: str
+    sigma_below: float = 0.0
+    gap_ratio: float = float("inf")
+    certain: bool = True
+    rank_candidates: tuple[int, int] = (0, 0)
+    sigmas: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0))
 
 
 def null_space(
-    J: sp.spmatrix | np.ndarray, tol: float | None = None, *, dense_limit: int = DENSE_LIMIT
+    J: sp.spmatrix | np.ndarray,
+    tol: float | None = None,
+    *,
+    dense_limit: int = DENSE_LIMIT,
+    gap_certain: float = GAP_CERTAIN,
 ) -> NullSpace:
-    """Rank and null space of ``J`` (m, n).
+    """Rank and null space of ``J`` (m, n), with the gap at the cut.
 
     Small matrices (n <= ``dense_limit``): dense SVD; a singular value counts as zero below
     ``tol`` (relative to sigma_max; default ``DENSE_TOL`` = 1e-8). Large sparse matrices: the
-    smallest eigenpairs of ``J^T J`` by shift-invert Lanczos (ARPACK, one sparse LU of
-    ``J^T J + c I``), doubling the number asked for until a non-zero one appears; a singular
-    value ``sqrt(lambda)`` counts as zero below ``tol`` (default ``SPARSE_TOL`` = 1e-6,
-    coarser because squaring loses half the digits).
+    nullity from the inertia of ``JᵀJ − τ²I`` (τ = ``tol`` sigma_max, default ``SPARSE_TOL``
+    = 1e-6) and the null space by shift-invert subspace iteration on that factorisation.
+
+    Raises
+    ------
+    RankError
+        A factorisation failed or the iteration did not reach the null space.
     """
     m, n = J.shape
     if n == 0:
         return NullSpace(0, np.zeros((0, 0)), 0.0, 0.0, np.nan, "svd")
-    if n <= dense_limit or m == 0:
-        A = J.toarray() if sp.issparse(J) else np.asarray(J, dtype=float)
-        if m == 0:
-            return NullSpace(0, np.eye(n), 0.0, 0.0, np.nan, "svd")
-        _, s, Vt = sla.svd(A, full_matrices=True, lapack_driver="gesdd")
-        smax = float(s[0]) if len(s) else 0.0
-        rel = DENSE_TOL if tol is None else tol
-        atol = rel * max(smax, 1e-300)
-        rank = int(np.sum(s > atol))
-        gap = float(s[rank - 1]) if rank > 0 else np.nan
-        return NullSpace(rank, Vt[rank:].T.copy(), atol, smax, gap, "svd")
-    J = sp.csr_matrix(J)
-    N = (J.T @ J).tocsc()
-    smax = float(np.sqrt(spla.eigsh(N, k=1, which="LA", return_eigenvectors=False, tol=1e-3)[0]))
+    try:
+        if n <= dense_limit or m == 0:
+            return _dense(J, tol, gap_certain)
+        return _sparse(sp.csr_matrix(J), tol, gap_certain)
+    except RankError:
+        raise
+    except (np.linalg.LinAlgError, RuntimeError, ValueError, MemoryError) as exc:
+        msg = f"rank of the {m} x {n} Jacobian failed: {type(exc).__name__}: {exc}"
+        raise RankError(msg) from exc
+
+
+def _judge(
+    s: np.ndarray, nz: int, smax: float, method: str, gap_certain: float, n: int
+) -> tuple[float, float, float, bool, tuple[int, int]]:
+    """sigma_gap, sigma_below, gap ratio, certainty and rank candidates from the ascending
+    singular values ``s`` nearest the cut, of which the first ``nz`` count as zero.
+
+    The ratio of a cut after ``j`` values is ``s[j] / max(s[j-1], floor)``; values at or
+    below the floor are zero for certain. An uncertain cut gives the range between the
+    nearest clear cuts (ratio >= ``gap_certain``) on either side, or the ends of the
+    computed values (the rank is then at least / at most that)."""
+    floor = _FLOOR[method] * max(smax, 1e-300)
+    below = float(s[nz - 1]) if nz > 0 else 0.0
+    gap = float(s[nz]) if nz < len(s) else np.nan
+
+    def ratio(j: int) -> float:
+        if j >= len(s):
+            return np.inf
+        return float(s[j] / max(s[j - 1] if j > 0 else 0.0, floor))
+
+    r = ratio(nz)
+    certain = bool(r >= gap_certain)
+    if certain:
+        return gap, below, r, certain, (n - nz, n - nz)
+    j_min = int(np.sum(s <= floor))
+    j_hi = next((j for j in range(nz - 1, j_min - 1, -1) if ratio(j) >= gap_certain), j_min)
+    j_lo = next((j for j in range(nz + 1, len(s) + 1) if ratio(j) >= gap_certain), len(s))
+    return gap, below, r, certain, (n - j_lo, n - j_hi)
+
+
+def _dense(J, tol: float | None, gap_certain: float) -> NullSpace:
+    m, n = J.shape
+    A = J.toarray() if sp.issparse(J) else np.asarray(J, dtype=float)
+    if m == 0:
+        return NullSpace(0, np.eye(n), 0.0, 0.0, np.nan, "svd", 0.0, np.inf, True, (0, 0))
+    _, s, Vt = sla.svd(A, full_matrices=True, lapack_driver="gesdd")
+    smax = float(s[0]) if len(s) else 0.0
+    rel = DENSE_TOL if tol is None else tol
+    atol = rel * max(smax, 1e-300)
+    rank = int(np.sum(s > atol))
+    full = np.zeros(n)
+    full[: len(s)] = s
+    asc = full[::-1]  # n values, ascending (missing ones are exact zeros)
+    nz = n - rank
+    gap, below, ratio, certain, cand = _judge(asc, nz, smax, "svd", gap_certain, n)
+    return NullSpace(
+        rank, Vt[rank:].T.copy(), atol, smax, gap, "svd", below, ratio, certain, cand, asc
+    )
+
+
+def _sigma_max(N: sp.csr_matrix, iters: int = 40) -> float:
+    """Largest singular value of J from ``N = JᵀJ`` by power iteration (deterministic start;
+    from below, a few per cent low after 40 steps: enough for a relative threshold)."""
+    rng = np.random.default_rng(0)
+    x = rng.standard_normal(N.shape[0])
+    lam = 0.0
+    for _ in range(iters):
+        y = N @ x
+        nrm = float(np.linalg.norm(y))
+        if nrm == 0.0:
+            return 0.0
+        lam = float(x @ y) / float(x @ x)
+        x = y / nrm
+    return float(np.sqrt(max(lam, 0.0)))
+
+
+class _Inertia:
+    """One LDLᵀ of a symmetric matrix that reports its negative pivots."""
+
+    def __init__(self, A: sp.csr_matrix) -> None:
+        self.neg: int | None = None
+        self.factor = None
+        self.name = ""
+        errors: list[str] = []
+        for name in ("pardiso", "superlu"):
+            try:
+                fac = _backend(name).factorize(A)
+            except Exception as exc:  # any library failure: try the next one
+                errors.append(f"{name}: {exc}")
+                continue
+            neg = fac.negative_pivots() if hasattr(fac, "negative_pivots") else None
+            if neg is None:
+                errors.append(f"{name}: no inertia (non-symmetric pivoting)")
+                continue
+            self.neg, self.factor, self.name = int(neg), fac, name
+            return
+        raise RankError("no factorisation of JᵀJ − τ²I reported its inertia: " + "; ".join(errors))
+
+
+def _backend(name: str):
+    from barhinge.linalg.backends import BACKENDS, PardisoBackend, _importable
+
+    if name == "pardiso":
+        if not _importable("pypardiso"):
+            raise RankError("pypardiso not installed")
+
+        class _Tight(PardisoBackend):
+            # pivots are perturbed only below 1e-13 (default 1e-8): the shifted normal
+            # matrix has pivots near -tau^2 ~ 1e-12 sigma_max^2 that must stay as they are
+            IPARM = {**PardisoBackend.IPARM, 10: 13}
+
+        return _Tight()
+    return BACKENDS[name][1]()
+
+
+def _sparse(J: sp.csr_matrix, tol: float | None, gap_certain: float) -> NullSpace:
+    m, n = J.shape
+    N = (J.T @ J).tocsr()
+    smax = _sigma_max(N)
+    if smax == 0.0:
+        return NullSpace(0, np.eye(n), 0.0, 0.0, np.nan, "sparse-inertia", 0.0, np.inf, True,
+                         (0, 0), np.zeros(n))  # fmt: skip
     rel = SPARSE_TOL if tol is None else tol
     atol = rel * smax
-    shift = 1e-10 * smax**2
-    lu = spla.splu((N + shift * sp.identity(n, format="csc")).tocsc())
-    op = spla.LinearOperator((n, n), matvec=lu.solve, dtype=float)
-    k = min(8, n - 1)
-    while True:
-        vals, vecs = spla.eigsh(N, k=k, sigma=-shift, which="LM", OPinv=op, tol=1e-12)
-        order = np.argsort(vals)
-        vals, vecs = vals[order], vecs[:, order]
-        sig = np.sqrt(np.clip(vals, 0.0, None))
-        zero = sig <= atol
-        nz = int(zero.sum())
-        if nz < k or k >= n - 1:
+    tau2 = atol**2
+    A = (N - tau2 * sp.identity(n, format="csr")).tocsr()
+    A.sort_indices()
+    inert = _Inertia(A)
+    nz = inert.neg
+    if nz >= n:
+        raise RankError(f"the inertia says all {n} singular values are below the cut")
+    b = min(n, nz + _EXTRA)
+    rng = np.random.default_rng(1)
+    X = np.linalg.qr(rng.standard_normal((n, b)))[0]
+    theta = np.zeros(b)
+    resid = np.inf
+    prev = np.full(b, np.inf)
+    for it in range(80):
+        Y = np.asarray(inert.factor.solve(X)).reshape(n, b)
+        Q = np.linalg.qr(Y)[0]
+        NQ = N @ Q
+        H = Q.T @ NQ
+        theta, W = np.linalg.eigh(0.5 * (H + H.T))
+        X = Q @ W
+        if nz:
+            R = NQ @ W[:, :nz] - X[:, :nz] * theta[:nz]
+            resid = float(np.abs(R).max())
+        # stop when the null vectors are converged and the smallest values above the cut
+        # (the gap) have settled to 1e-4
+        above = slice(nz, min(b, nz + 2))
+        settled = np.all(np.abs(theta[above] - prev[above]) <= 1e-4 * np.abs(theta[above]))
+        if resid <= 1e-3 * tau2 and settled and it >= 2:
             break
-        k = min(2 * k, n - 1)
-    basis, _ = np.linalg.qr(vecs[:, zero]) if nz else (np.zeros((n, 0)), None)
-    gap = float(sig[nz]) if nz < len(sig) else np.nan
-    return NullSpace(n - nz, basis, atol, smax, gap, "sparse-eigsh")
+        prev = theta.copy()
+    sig = np.linalg.norm(J @ X, axis=0)  # Rayleigh quotients of J: accurate below the cut
+    order = np.argsort(sig)
+    sig, X = sig[order], X[:, order]
+    counted = int(np.sum(sig[:nz] <= atol)) if nz else 0
+    if nz and (counted != nz or resid > 1e-2 * tau2):
+        raise RankError(
+            f"the shift-invert iteration found {counted} of the {nz} singular values below the "
+            f"cut {atol:.1e} that the inertia counts (residual {resid:.1e})"
+        )
+    basis = np.linalg.qr(X[:, :nz])[0] if nz else np.zeros((n, 0))
+    gap, below, ratio, certain, cand = _judge(sig, nz, smax, "sparse-inertia", gap_certain, n)
+    log.debug("sparse rank: nullity %d by %s inertia, gap ratio %.2e", nz, inert.name, ratio)
+    return NullSpace(n - nz, basis, atol, smax, gap, "sparse-inertia", below, ratio, certain,
+                     cand, sig)  # fmt: skip

@@ -256,16 +256,32 @@ class CreasePattern:
 
     @cached_property
     def boundary_edges(self) -> np.ndarray:
-        """(k,) int: edges with fewer than two faces (or assigned B)."""
+        """(k,) int: edges with fewer than two faces.
+
+        An edge assigned B that two faces share is not a boundary: the sheet is continuous
+        across it, so it is treated as an unassigned crease (see :attr:`crease_edges`;
+        validation reports it as ``"interior-boundary-edge"``)."""
         EF = self.edge_faces
-        return _readonly(np.flatnonzero((EF < 0).any(1) | (self.assignment == "B")))
+        return _readonly(np.flatnonzero((EF < 0).any(1)))
 
     @cached_property
     def crease_edges(self) -> np.ndarray:
-        """(k,) int: interior edges that can fold (two faces, assignment M, V, F or U)."""
+        """(k,) int: interior edges that can fold (two faces, assignment M, V, F or U, and B
+        between two faces, treated as U)."""
         EF = self.edge_faces
-        ok = (EF >= 0).all(1) & np.isin(self.assignment, ("M", "V", "F", "U"))
+        ok = (EF >= 0).all(1) & np.isin(self.assignment, ("M", "V", "F", "U", "B"))
         return _readonly(np.flatnonzero(ok))
+
+    @cached_property
+    def is_planar(self) -> bool:
+        """True if all vertices lie in one plane, in any orientation (to 1e-9 of the pattern
+        size; judged from the best-fit plane: the smallest principal direction)."""
+        V = self.vertices
+        if V.shape[1] == 2 or self.n_vertices <= 3:
+            return True
+        C = V - V.mean(0)
+        normal = np.linalg.svd(C, full_matrices=False)[2][-1]
+        return bool(np.all(np.abs(C @ normal) <= 1e-9 * max(self.size, 1e-300)))
 
     @cached_property
     def boundary_vertices(self) -> np.ndarray:

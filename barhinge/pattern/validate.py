@@ -461,6 +461,17 @@ def _face_findings(c: _Ctx) -> list[Finding]:
                     int(e),
                 )
             )
+        for e in np.flatnonzero((A == "B") & (nl == 1) & (nr == 1))[:20]:
+            out.append(
+                Finding(
+                    "interior-boundary-edge",
+                    f"edge {e} {E[e].tolist()} is assigned B but borders two faces; treated as "
+                    "an unassigned crease (U), the sheet being continuous across it (assign C "
+                    "for a cut)",
+                    int(e),
+                    "warning",
+                )
+            )
         for e in np.flatnonzero(((nl > 1) | (nr > 1)) & (nl + nr <= 2)):
             faces_ok = False
             out.append(

@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
+import scipy.sparse as sp
 from typer.testing import CliRunner
 
 import barhinge as bh
@@ -49,3 +51,29 @@ def test_draw_dof_returns_figure_with_actuators_marked():
     import matplotlib.pyplot as plt
 
     plt.close(fig)
+
+
+def test_dof_command_states_the_gap_and_library_failures_exit_3(monkeypatch):
+    """The table shows the singular values on both sides of the cut and the gap ratio; a
+    failing numerical library is a one-line error with exit code 3, not a traceback."""
+    from barhinge.cli import main
+    from barhinge.linalg import nullspace as nsm
+
+    res = CliRunner().invoke(app, ["dof", "miura:nx=2,ny=2"])
+    assert res.exit_code == 0, res.output
+    assert "gap ratio" in res.output and "certain" in res.output
+    data = json.loads(CliRunner().invoke(app, ["dof", "miura:nx=2,ny=2", "--json"]).output)
+    assert data["folded_state"]["certain"] is True
+    assert data["folded_state"]["gap_ratio"] > 1e3
+    assert data["folded_state"]["dof_range"] == [1, 1]
+
+    class Broken:
+        def factorize(self, A):
+            raise RuntimeError("simulated MKL failure")
+
+    monkeypatch.setattr(nsm, "_backend", lambda name: Broken())
+    monkeypatch.setattr(nsm, "_dense", lambda J, tol, g: nsm._sparse(sp.csr_matrix(J), tol, g))
+
+    with pytest.raises(SystemExit) as exc:
+        main(["dof", "miura:nx=2,ny=2", "--json"])
+    assert exc.value.code == 3
