@@ -80,54 +80,12 @@ def _root(
 
 def print_json(data: object) -> None:
     """Print machine-readable output (for ``--json``)."""
-    sys.stdout.write(json.dumps(data, indent=2, default=_json_default) + "\n")
+    from barhinge._json import default
 
-
-def _json_default(o: object) -> object:
-    import numpy as np
-
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, Path):
-        return str(o)
-    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+    sys.stdout.write(json.dumps(data, indent=2, default=default) + "\n")
 
 
 # --- commands: info (foundation) ---
-
-
-def pattern_info(cp, findings_list) -> dict:
-    """Summary of a crease pattern for ``barhinge info`` (JSON-serialisable)."""
-    import numpy as np
-
-    from barhinge._typing import ASSIGNMENTS
-
-    V = cp.vertices
-    deg = cp.vertex_degree
-    values, counts = np.unique(deg, return_counts=True)
-    holes = [f for f in findings_list if f.code == "hole"]
-    return {
-        "n_vertices": cp.n_vertices,
-        "n_edges": cp.n_edges,
-        "edges_by_assignment": {a: int((cp.assignment == a).sum()) for a in ASSIGNMENTS},
-        "n_faces": cp.n_faces,
-        "n_interior_vertices": int(len(cp.interior_vertices)),
-        "n_boundary_vertices": int(len(cp.boundary_vertices)),
-        "degree_histogram": {int(v): int(c) for v, c in zip(values, counts, strict=True)},
-        "dimension": int(V.shape[1]),
-        "flat": bool(cp.is_planar),
-        "bounding_box": {
-            "min": V.min(0).tolist() if len(V) else [],
-            "max": V.max(0).tolist() if len(V) else [],
-        },
-        "size": cp.size,
-        "n_holes": len(holes),
-        "developable": cp.developable,
-        "findings": [f.as_dict() for f in findings_list],
-        "n_errors": sum(f.severity == "error" for f in findings_list),
-    }
 
 
 @app.command()
@@ -153,6 +111,7 @@ def info(
     from rich.markup import escape
     from rich.table import Table
 
+    from barhinge.pattern.info import pattern_info
     from barhinge.pattern.io import read
     from barhinge.pattern.validate import findings
 
@@ -196,40 +155,6 @@ def info(
 # --- commands: patterns (pattern library) ---
 
 
-def _parse_param_value(text: str) -> object:
-    """A ``--param`` value: JSON (numbers, lists, true/false/null), a comma list of numbers,
-    or a plain string."""
-    try:
-        return json.loads(text)
-    except ValueError:
-        pass
-    if "," in text:
-        try:
-            return [float(x) for x in text.split(",")]
-        except ValueError:
-            pass
-    return text
-
-
-def _pattern_params(name: str, items: list[str]) -> dict[str, object]:
-    from barhinge.errors import PatternError
-    from barhinge.patterns import family_parameters
-
-    known = family_parameters(name)
-    out: dict[str, object] = {}
-    for item in items:
-        key, sep, value = item.partition("=")
-        key = key.strip()
-        if not sep or not key:
-            raise PatternError(f"--param {item!r}: expected NAME=VALUE")
-        if key not in known:
-            raise PatternError(
-                f"{name}: unknown parameter {key!r}; expected one of {', '.join(known)}"
-            )
-        out[key] = _parse_param_value(value.strip())
-    return out
-
-
 @app.command("patterns")
 def patterns_cmd(
     name: Annotated[
@@ -249,29 +174,13 @@ def patterns_cmd(
     as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
 ) -> None:
     """List the parametric pattern families, or generate one (``--out FILE.fold``)."""
-    import inspect
-
     from rich.table import Table
 
-    from barhinge.patterns import (
-        FAMILIES,
-        FOLDABLE_FAMILIES,
-        family_parameters,
-        family_summary,
-    )
-
-    def shown(v: object) -> object:
-        return "(required)" if v is inspect.Parameter.empty else v
+    from barhinge.pattern.info import generated_info
+    from barhinge.patterns.spec import catalogue, family_kwargs, generate
 
     if name is None:
-        data = {
-            fam: {
-                "parameters": {k: shown(v) for k, v in family_parameters(fam).items()},
-                "exact_fold": fam in FOLDABLE_FAMILIES,
-                "summary": family_summary(fam),
-            }
-            for fam in FAMILIES
-        }
+        data = catalogue()
         if as_json:
             print_json(data)
             return
@@ -285,29 +194,8 @@ def patterns_cmd(
             t.add_row(fam, ps, "exact" if d["exact_fold"] else "", d["summary"])
         console.print(t)
         return
-    kwargs = _pattern_params(name, list(param or []))
-    try:
-        cp = FAMILIES[name](**kwargs)
-    except TypeError as exc:  # e.g. a list given where a number is expected
-        from barhinge.errors import PatternError
-
-        raise PatternError(f"{name}: bad parameter value ({exc})") from None
-    summary = {
-        "family": name,
-        "parameters": cp.meta.get("barhinge:parameters", {}),
-        "n_vertices": cp.n_vertices,
-        "n_edges": cp.n_edges,
-        "n_faces": cp.n_faces,
-        "n_interior_vertices": int(len(cp.interior_vertices)),
-        "edges_by_assignment": {
-            a: int((cp.assignment == a).sum())
-            for a in ("M", "V", "F", "B")
-            if (cp.assignment == a).any()
-        },
-        "folded": bool(not cp.is_flat),
-        "developable": bool(cp.developable),
-        "out": str(out) if out else None,
-    }
+    cp = generate(name, family_kwargs(name, param or []))
+    summary = {**generated_info(name, cp), "out": str(out) if out else None}
     if out is not None:
         from barhinge.pattern.fold import write_fold
 
@@ -324,41 +212,6 @@ def patterns_cmd(
 
 
 # --- commands: dof (kinematics) ---
-
-
-def _dof_pattern(spec: str):
-    """A pattern from a file path (.fold/.svg) or a family spec ``name[:key=value,...]``
-    (e.g. ``miura:nx=4,ny=4,alpha=60``)."""
-    from barhinge.errors import ConfigError
-
-    if Path(spec).exists():
-        from barhinge.pattern.io import read
-
-        return read(spec)
-    from barhinge import patterns
-
-    name, _, args = spec.partition(":")
-    gen = patterns.FAMILIES.get(name)
-    if gen is None:
-        raise ConfigError(
-            f"{spec!r} is neither a file nor a pattern family; families: "
-            f"{', '.join(sorted(patterns.FAMILIES))}"
-        )
-    known = patterns.family_parameters(name)
-    kw: dict[str, object] = {}
-    for item in filter(None, args.split(",")):
-        key, eq, val = item.partition("=")
-        if not eq or not key.strip():
-            raise ConfigError(f"family argument {item!r} must be key=value")
-        if key.strip() not in known:
-            raise ConfigError(
-                f"{name}: unknown parameter {key.strip()!r}; expected one of {', '.join(known)}"
-            )
-        try:
-            kw[key.strip()] = json.loads(val)
-        except json.JSONDecodeError:
-            kw[key.strip()] = val
-    return gen(**kw)
 
 
 #: picture formats of ``barhinge dof --png`` (matplotlib picks the format from the suffix)
@@ -393,7 +246,9 @@ def dof(
             f"--png {png}: expected a picture file ending in "
             f"{', '.join(_PICTURE_SUFFIXES[:-1])} or {_PICTURE_SUFFIXES[-1]}"
         )
-    cp = _dof_pattern(pattern)
+    from barhinge.patterns.spec import read_or_generate
+
+    cp = read_or_generate(pattern)
     rep = compute_dof(cp, triangulated=triangulated, prefer=prefer)
     if png is not None:
         from barhinge.plot.dof import draw_dof
@@ -446,74 +301,6 @@ def dof(
         console.print(f"wrote {png}")
 
 
-# --- fold --form-only: model no more than a scene needs (studies) ---
-
-
-def form_only_model(scene) -> tuple[str, str]:
-    """("rigid" | "bar-hinge", reason): the model a scene needs when only its folded form is
-    wanted. Rigid kinematics is exact and fastest for a form driven by actuators alone
-    (docs/speed-accuracy.md); loads or prescribed displacements need the compliant model."""
-    import numpy as np
-
-    if scene.actuators is None or not scene.actuators.n:
-        return "bar-hinge", "no actuators"
-    if np.any(scene.loads) or np.isfinite(scene.prescribed).any():
-        return "bar-hinge", "the scene has loads or prescribed displacements"
-    return "rigid", "actuators only"
-
-
-def _fold_form_rigid(scene, out: Path, overwrite: bool = False) -> tuple[object, dict] | None:
-    """Fold ``scene`` by rigid kinematics and write fold_path.npz, fold_path.fold and
-    summary.json into ``out``; None (with the reason on stderr) when rigid kinematics cannot
-    follow the actuators, so the caller falls back to the bar-and-hinge solver."""
-    import time
-
-    import numpy as np
-
-    from barhinge.kinematics.path import RigidOptions, rigid_fold
-    from barhinge.pattern.fold import write_fold_path
-    from barhinge.solve.branch import fold_weights
-
-    cp = scene.model.pattern  # its state is the model's reference state X0
-    t0 = time.perf_counter()
-    try:
-        # no DOF recount per state (a diagnostic that costs a dense SVD per state)
-        opts = RigidOptions(max_cutbacks=3, check_rank=False, over_actuated="error")
-        # free motions resolved with the model's own fold springs (its rigid limit)
-        weights, _ = fold_weights(scene.model)
-        path = rigid_fold(
-            cp, scene.actuators, steps=scene.steps, options=opts, fold_stiffness=weights
-        )
-    except BarhingeError as exc:
-        err_console.print(f"rigid kinematics cannot fold it ({exc}); using the bar-and-hinge model",
-                          highlight=False, markup=False, soft_wrap=True)  # fmt: skip
-        return None
-    rho = path.fold_angles_deg[-1]
-    info = {
-        "scene": scene.name,
-        "model": "rigid",
-        "n_states": int(path.n_states),
-        "wall_time_s": time.perf_counter() - t0,
-        "max_abs_fold_deg": float(np.max(np.abs(rho))) if len(rho) else 0.0,
-        "actuators": {
-            "edges": scene.actuators.edges.tolist(),
-            "angle_deg": rho[scene.actuators.edges].tolist(),
-        },
-        "closure_residual": path.meta.get("max_residual"),
-    }
-    from barhinge.io import MANIFEST, result_folder
-
-    with result_folder(out, overwrite=overwrite, command="fold --form-only") as run:
-        path.save(run.path / "fold_path.npz")
-        write_fold_path(cp, path, run.path / "fold_path.fold")
-        js = json.dumps(info, indent=2, default=_json_default) + "\n"
-        (run.path / "summary.json").write_text(js)
-        run.manifest.update(scene=scene.name, kind="rigid", converged=True, reason=None,
-                            message="", n_states=int(path.n_states))  # fmt: skip
-    files = [out / n for n in ("fold_path.npz", "fold_path.fold", "summary.json", MANIFEST)]
-    return path, {**info, "files": [str(f) for f in files]}
-
-
 # --- commands: fold (solver) ---
 
 
@@ -541,31 +328,33 @@ def fold_cmd(
         ),
     ] = False,
 ) -> None:
-    """Fold a scene: solve it step by step, write the fold path and a summary.
+    """Fold a scene: solve it step by step, write the fold path, one summary and one step
+    table (docs/outputs.md).
 
-    The output folder is replaced atomically at the end (docs/results.md); Ctrl-C writes
-    the converged steps and exits with code 130.
+    The output folder is replaced atomically at the end; Ctrl-C writes the converged steps
+    and exits with code 130.
     """
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
-    from rich.table import Table
 
-    from barhinge.io import check_output_folder
+    from barhinge.output.folder import check_output_folder
+    from barhinge.output.run import write_run
     from barhinge.results import Interrupted
     from barhinge.scene import default_scene, load_scene
+    from barhinge.solve.form import form_only_model, rigid_form
     from barhinge.solve.newton import solve
-    from barhinge.solve.outputs import summary, write_outputs
 
     scene = default_scene() if scene_file is None else load_scene(scene_file)
     check_output_folder(out, overwrite=overwrite)  # before the solve, not after
     if form_only and form_only_model(scene)[0] == "rigid":
-        done = _fold_form_rigid(scene, out, overwrite)
-        if done is not None:
-            if as_json:
-                print_json(done[1])
-            else:
-                console.print(f"fold --form-only: {scene.name} folded by rigid kinematics, "
-                              f"{done[1]['n_states']} states, {done[1]['wall_time_s']:.2f} s "
-                              f"-> {out}", highlight=False)  # fmt: skip
+        try:
+            rigid = rigid_form(scene)
+        except BarhingeError as exc:
+            err_console.print(f"rigid kinematics cannot fold it ({exc}); using the bar-and-hinge "
+                              "model", highlight=False, markup=False, soft_wrap=True)  # fmt: skip
+        else:
+            run = write_run(rigid, scene, out, overwrite=overwrite, command="fold --form-only",
+                            fields=False)  # fmt: skip
+            _print_run(run, f"fold --form-only: {scene.name} (rigid kinematics)", as_json)
             return
     bar = Progress(
         TextColumn(f"[bold]{scene.name}[/]"),
@@ -589,12 +378,12 @@ def fold_cmd(
                         part = dataclasses.replace(
                             part, message=part.message.replace("(Ctrl-C)", "(SIGTERM)")
                         )
-                    write_outputs(part, scene, out, overwrite=overwrite)
-                    _print_events(part, err_console)
+                    write_run(part, scene, out, overwrite=overwrite)
+                    _print_events(part.meta.get("events", []), err_console)
                     err_console.print(f"partial results ({part.n_states} states) in {out}",
                                       highlight=False, markup=False)  # fmt: skip
                 raise
-        files = write_outputs(path, scene, out, overwrite=overwrite)
+        run = write_run(path, scene, out, overwrite=overwrite)
     except Interrupted as exc:
         stop = _terminated(exc)
         part = exc.last_state
@@ -609,73 +398,29 @@ def fold_cmd(
         sys.exit(EXIT_TERMINATED if _terminated(exc) else 130)
     finally:
         term.close()
-    info = summary(path, scene)
-    from barhinge.plot import results_rows, results_summary
+    _print_run(run, f"fold: {scene.name}", as_json)
 
+
+def _print_run(run, title: str, as_json: bool) -> None:
+    """The summary of a written run: JSON (``--json``) or a table, then its events."""
     if as_json:
-        print_json({**info, "results": results_summary(out), "files": [str(f) for f in files]})
+        print_json({**run.summary, "files": [str(f) for f in run.files]})
         return
-    t = Table(title=f"fold: {scene.name}")
+    from rich.table import Table
+
+    t = Table(title=title)
     t.add_column("quantity")
     t.add_column("value", justify="right")
-    t.add_row("DOF", str(info["n_dof"]))
-    t.add_row("states", str(info["n_states"]))
-    t.add_row("Newton iterations", str(info["newton_iterations"]))
-    t.add_row("wall time (s)", f"{info['wall_time_s']:.2f}")
-    t.add_row("linear solver", str(info.get("linear_solver")))
-    for k, v in info["energy"].items():
-        t.add_row(f"energy {k}", f"{v:.6g}")
-    share = energy_share_text(path)
-    if share:
-        t.add_row("energy share", share)
-    flat = flat_start_text(path)
-    if flat:
-        t.add_row("flat start", flat)
-    if info["actuators"]["moment"]:
-        m = [abs(float(v)) for v in info["actuators"]["moment"]]
-        t.add_row("max |actuator moment|", f"{max(m):.6g}")
-    for k, v in results_rows(out):
+    for k, v in run.rows:
         t.add_row(k, v)
-    t.add_row("output", str(out))
+    t.add_row("output", str(run.out))
     console.print(t)
-    _print_events(path, console)
+    _print_events(run.summary["events"], console)
 
 
-def _percent(x: float) -> str:
-    p = 100.0 * x
-    return f"{p:.1f} %" if p == 0.0 or abs(p) >= 0.1 else f"{p:.1g} %"
-
-
-def energy_share_text(path) -> str:
-    """The last state's energy split as one line ("folds 99.5 %, panel bending 0.4 %,
-    bars 0.1 %"); "" when the total is zero or unknown (rigid paths)."""
-    from barhinge.analysis.summary import energy_split
-
-    e = energy_split(path)
-    if e["energy_fraction_fold"] is None:
-        return ""
-    parts = (("folds", "fold"), ("panel bending", "bend"), ("bars", "bars"))
-    return ", ".join(f"{label} {_percent(e[f'energy_fraction_{k}'])}" for label, k in parts)
-
-
-def flat_start_text(path) -> str:
-    """``meta["flat_start"]`` as one line ("rigid panels, M/V assignment"); "" without it."""
-    rec = path.meta.get("flat_start")
-    if not rec:
-        return ""
-    words = [str(rec.get("predictor", "?"))]
-    if rec.get("branch"):
-        words.append(str(rec["branch"]))
-    if rec.get("mirrored"):
-        words.append("mirrored")
-    if rec.get("sign_conflicts"):
-        words.append(f"{len(rec['sign_conflicts'])} crease(s) against the branch signs")
-    return ", ".join(words)
-
-
-def _print_events(path, to) -> None:
-    """The path's stability and work-balance events, one line each."""
-    for ev in path.meta.get("events", []):
+def _print_events(events, to) -> None:
+    """Stability and work-balance events, one line each."""
+    for ev in events:
         to.print(f"event: {ev}", highlight=False, markup=False)
 
 
@@ -748,7 +493,7 @@ def render(
 ) -> None:
     """Re-render the pictures of a saved fold path (PNG of one state, charts, GIF)."""
     from barhinge.errors import ConfigError
-    from barhinge.io import add_to_manifest, atomic_file
+    from barhinge.output.folder import add_to_manifest, atomic_file
     from barhinge.plot import charts
     from barhinge.plot import render as rnd
     from barhinge.results import FoldPath

@@ -58,6 +58,7 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any, Literal
 
+from barhinge._json import default
 from barhinge.errors import ConfigError
 
 __all__ = [
@@ -83,21 +84,13 @@ _RESERVED = ("id", "status", "error_type", "error_message", "elapsed_s", "worker
 
 
 # ------------------------------------------------------------------------------ identity
-def _json_default(o: object) -> object:
-    if hasattr(o, "tolist"):  # numpy arrays and scalars
-        return o.tolist()
-    if isinstance(o, Path):
-        return str(o)
-    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
-
-
 def _canonical(params: dict[str, Any]) -> str:
-    return json.dumps(params, sort_keys=True, separators=(",", ":"), default=_json_default)
+    return json.dumps(params, sort_keys=True, separators=(",", ":"), default=default)
 
 
 def _dumps(obj: Any, **kw: Any) -> str:
     """Strict JSON (ValueError on NaN or an infinity), numpy values converted."""
-    return json.dumps(obj, default=_json_default, allow_nan=False, **kw)
+    return json.dumps(obj, default=default, allow_nan=False, **kw)
 
 
 def _non_finite(v: Any, where: str, found: list[str]) -> Any:
@@ -339,7 +332,7 @@ def _run_point(fn: Callable[..., Any], pid: str, params: dict[str, Any]) -> Reco
         if not isinstance(res, dict):
             res = {"value": res}
         found: list[str] = []
-        rec["result"] = _non_finite(json.loads(json.dumps(res, default=_json_default)), "", found)
+        rec["result"] = _non_finite(json.loads(json.dumps(res, default=default)), "", found)
         if found:  # kept as null; the point failed (a NaN is no result, and not strict JSON)
             rec["status"] = "failed"
             more = f" ({len(found)} non-finite values)" if len(found) > 1 else ""

@@ -31,7 +31,16 @@ PACKAGE = ROOT / "barhinge"
 #: layer with a matching wildcard (fnmatch on the dotted name) does. Keep in step with
 #: docs/architecture.md.
 LAYERS: list[tuple[str, list[str]]] = [
-    ("ground", ["barhinge.errors", "barhinge._typing", "barhinge._check", "barhinge._version"]),
+    (
+        "ground",
+        [
+            "barhinge.errors",
+            "barhinge._typing",
+            "barhinge._check",
+            "barhinge._version",
+            "barhinge._json",
+        ],
+    ),
     ("linalg", ["barhinge.linalg", "barhinge.linalg.*"]),
     ("results", ["barhinge.results"]),
     ("pattern", ["barhinge.pattern", "barhinge.pattern.*"]),
@@ -43,9 +52,20 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("scene", ["barhinge.solver_options", "barhinge.scene"]),
     ("solve", ["barhinge.solve", "barhinge.solve.*"]),
     ("analysis", ["barhinge.analysis", "barhinge.analysis.*"]),
-    # solve/outputs.py writes the result folder of a solved scene: an output module that lives
-    # in solve/ by name only (nothing in the solver imports it)
-    ("output", ["barhinge.solve.outputs", "barhinge.io", "barhinge.plot", "barhinge.plot.*"]),
+    # what output/ writes, as data: fields on the mesh (meshio), the step table, the summary,
+    # the result folder; below the pictures, which draw those fields
+    (
+        "output data",
+        [
+            "barhinge.output.fields",
+            "barhinge.output.table",
+            "barhinge.output.summary",
+            "barhinge.output.folder",
+        ],
+    ),
+    ("plot", ["barhinge.plot", "barhinge.plot.*"]),
+    # the one writer of a run (run.py) and its pictures (pictures.py)
+    ("output", ["barhinge.output", "barhinge.output.*"]),
     ("apps", ["barhinge.verify", "barhinge.sweep"]),
     ("cli", ["barhinge.cli", "barhinge.__main__"]),
     ("api", ["barhinge"]),

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from barhinge._json import jsonable
 from barhinge.errors import PatternError
 from barhinge.pattern.crease import CreasePattern
 
@@ -153,7 +154,7 @@ def build_pattern(
     meta: dict[str, Any] = {
         "frame_title": f"{family} " + " ".join(f"{k}={_fmt(v)}" for k, v in parameters.items()),
         "barhinge:family": family,
-        "barhinge:parameters": {k: _jsonable(v) for k, v in parameters.items()},
+        "barhinge:parameters": {k: jsonable(v) for k, v in parameters.items()},
     }
     if extra_meta:
         meta.update(extra_meta)
@@ -174,18 +175,6 @@ def _fmt(v: Any) -> str:
     if isinstance(v, (list, tuple)):
         return "[" + ",".join(_fmt(x) for x in v) + "]"
     return str(v)
-
-
-def _jsonable(v: Any) -> Any:
-    if isinstance(v, np.ndarray):
-        return v.tolist()
-    if isinstance(v, np.generic):
-        return v.item()
-    if isinstance(v, tuple):
-        return [_jsonable(x) for x in v]
-    if isinstance(v, list):
-        return [_jsonable(x) for x in v]
-    return v
 
 
 # -------------------------------------------------------------- grid layouts

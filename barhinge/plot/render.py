@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from barhinge.errors import BarhingeError, ConfigError
-from barhinge.io import StateData, state_data
+from barhinge.output.fields import StateData, state_data
 
 __all__ = [
     "RenderError",
@@ -423,7 +423,7 @@ def render_state(
     path : path
         Output PNG.
     model, pattern : optional
-        Mesh and data source (see :func:`barhinge.io.state_data`); one is required.
+        Mesh and data source (see :func:`barhinge.output.fields.state_data`); one is required.
     scalars : str or array or None
         A name of :data:`ARRAYS` (``fold_angle_deg`` colours the creases, ``angle_defect`` /
         ``defect_density`` / ``displacement`` the nodes, ``energy_density`` the panels), or

@@ -13,7 +13,8 @@ from typer.testing import CliRunner
 
 import barhinge as bh
 from barhinge.analysis.summary import energy_split, summarize
-from barhinge.cli import app, energy_share_text, flat_start_text
+from barhinge.cli import app
+from barhinge.output.summary import energy_share_text, flat_start_text
 
 MAT = bh.Material(E=1e6, nu=0.3, t=0.01)
 KEYS = ("fold", "bend", "bars")
@@ -104,7 +105,7 @@ def test_fold_command_prints_the_split_and_the_flat_start(tmp_path):
     assert "energy share" in text and "panel bending" in text
     assert "flat start" in text and "rigid panels" in text
     fp = bh.FoldPath.load(out / "fold_path.npz")
-    rec = json.loads((out / "fold_path_summary.json").read_text())["summary"]
+    rec = json.loads((out / "summary.json").read_text())["results"]
     ref = _recomputed(bh.load_scene(scene).model, fp.X[-1])
     total = sum(ref.values())
     assert sum(rec[f"energy_fraction_{k}"] for k in KEYS) == pytest.approx(1.0, abs=1e-12)

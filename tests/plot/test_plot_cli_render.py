@@ -11,7 +11,7 @@ from typer.testing import CliRunner
 
 from barhinge import FoldPath
 from barhinge.cli import app
-from barhinge.io import write_results
+from barhinge.output.run import write_results
 
 patterns = pytest.importorskip("barhinge.patterns")
 pytest.importorskip("barhinge.pattern.fold")

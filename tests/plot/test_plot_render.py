@@ -13,7 +13,7 @@ from PIL import Image
 from barhinge.errors import ConfigError
 
 spec = importlib.util.spec_from_file_location(
-    "_io_fixtures", Path(__file__).resolve().parents[1] / "io" / "test_io_results.py"
+    "_io_fixtures", Path(__file__).resolve().parents[1] / "output" / "test_output_fields.py"
 )
 _fx = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(_fx)

@@ -158,7 +158,7 @@ def test_failed_landing_on_load_factor_one_raises(monkeypatch):
 
 def test_cli_fold_exits_3_when_arc_length_stops_at_its_cap(tmp_path, monkeypatch, capsys):
     from barhinge.cli import main
-    from barhinge.solve.outputs import summary
+    from barhinge.output.summary import run_summary
 
     scene = (
         "name = 'roof-arc'\n"
@@ -183,7 +183,9 @@ def test_cli_fold_exits_3_when_arc_length_stops_at_its_cap(tmp_path, monkeypatch
     part = bh.FoldPath.load(out / "fold_path.npz")
     assert not part.converged and part.load_factor[-1] < 1.0 and part.n_states == 16
     info = json.loads((out / "summary.json").read_text())
-    assert info == json.loads(json.dumps(summary(part)))  # written from the partial path
+    results = info.pop("results")  # the final-state analysis, under its own key
+    assert info == json.loads(json.dumps(run_summary(part)))  # written from the partial path
+    assert results["converged"] is False and results["n_states"] == part.n_states
     assert not info["converged"] and any("limit point" in e for e in info["events"])
 
 

@@ -12,12 +12,15 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 from typer.testing import CliRunner
 
 import barhinge as bh
-from barhinge.cli import app, form_only_model
+from barhinge.cli import app
+from barhinge.errors import ConfigError
 from barhinge.results import FoldPath
 from barhinge.scene import load_scene, miura_line_creases
+from barhinge.solve.form import form_only_model, rigid_form
 
 SCENES = Path(__file__).resolve().parents[2] / "data" / "scenes"
 
@@ -51,6 +54,8 @@ def test_form_only_folds_actuated_scene_rigidly_to_the_closed_form(tmp_path: Pat
     assert res.exit_code == 0, res.output
     info = json.loads(res.stdout)
     assert info["model"] == "rigid" and info["n_states"] == 7
+    assert info == {**json.loads((out / "summary.json").read_text()), "files": info["files"]}
+    assert info["closure_residual"] < 1e-8
     path = FoldPath.load(out / "fold_path.npz")
     assert path.kind == "rigid"
     ref = np.asarray(bh.patterns.miura(3, 3, fold=40.0).fold_angles)
@@ -69,8 +74,6 @@ def test_form_only_resolves_free_motions_as_the_rigid_limit(tmp_path: Path) -> N
     motions: rigid kinematics resolves them by minimising the model's fold-spring energy,
     and the form agrees with the bar-and-hinge model made 1e5 x stiffer in its panels (an
     independent solver; the gap is O(1 / ratio))."""
-    from barhinge.cli import _fold_form_rigid
-
     cp = bh.patterns.yoshimura(4, 3, fold=5.0)
     flat = np.asarray(bh.patterns.yoshimura(4, 3).vertices)
     E = np.asarray(cp.edges)
@@ -83,7 +86,7 @@ def test_form_only_resolves_free_motions_as_the_rigid_limit(tmp_path: Path) -> N
     model = bh.BarHingeModel.from_pattern(cp, "N5B8")
     scene = bh.Scene(model, actuators=acts, steps=2)
     assert form_only_model(scene)[0] == "rigid"
-    path, info = _fold_form_rigid(scene, tmp_path / "out")
+    path = rigid_form(scene)
     assert path.converged and path.meta["free_dof"] == 3
     stiff = bh.BarHingeModel.from_pattern(cp, "N5B8", stiffness_ratio=1e5)
     bar = bh.solve(bh.Scene(stiff, actuators=acts, steps=2))
@@ -93,10 +96,7 @@ def test_form_only_resolves_free_motions_as_the_rigid_limit(tmp_path: Path) -> N
 
 def test_form_only_falls_back_when_rigid_kinematics_cannot_follow(tmp_path: Path) -> None:
     """Two creases of a 1-DOF Miura driven with targets that contradict each other: rigid
-    kinematics refuses (ConfigError) and the CLI falls back to the bar-and-hinge solver
-    (helper returns None, nothing written)."""
-    from barhinge.cli import _fold_form_rigid
-
+    kinematics refuses (ConfigError) and the CLI falls back to the bar-and-hinge solver."""
     cp = bh.patterns.miura(2, 2, fold=30.0)
     lay = bh.patterns.miura_layout(2, 2)
     z, s = int(lay.interior_zigzag_edges[0]), int(lay.interior_straight_edges[0])
@@ -104,5 +104,5 @@ def test_form_only_falls_back_when_rigid_kinematics_cannot_follow(tmp_path: Path
         edges=[z, s], targets_deg=[cp.fold_angles[z] * 1.5, cp.fold_angles[s] * 0.5]
     )
     scene = bh.Scene(bh.BarHingeModel.from_pattern(cp, "N5B8"), actuators=acts, steps=2)
-    assert _fold_form_rigid(scene, tmp_path / "out") is None
-    assert not (tmp_path / "out").exists()
+    with pytest.raises(ConfigError):
+        rigid_form(scene)

@@ -1,4 +1,4 @@
-"""The ``barhinge fold`` output hook writes the result files, pictures and summary rows."""
+"""The one writer of a path writes the result files, pictures and the summary rows."""
 
 from __future__ import annotations
 
@@ -9,13 +9,14 @@ import numpy as np
 import pytest
 
 import barhinge as bh
-from barhinge.plot import fold_outputs_hook, results_rows
+from barhinge.output.run import write_results
+from barhinge.output.summary import summary_rows
 
 pytest.importorskip("barhinge.model.model")
 patterns = pytest.importorskip("barhinge.patterns")
 
 
-def test_fold_outputs_hook(tmp_path, monkeypatch):
+def test_write_results_writes_files_pictures_and_rows(tmp_path, monkeypatch):
     monkeypatch.setenv("BARHINGE_OFFSCREEN", "0")  # matplotlib pictures: fast and GL-free
     cp = patterns.miura(2, 2, fold=30.0)
     model = bh.BarHingeModel.from_pattern(cp, material=bh.Material(E=1e3, nu=0.3, t=0.01))
@@ -31,14 +32,16 @@ def test_fold_outputs_hook(tmp_path, monkeypatch):
     from barhinge.scene import restraint_321, self_weight
 
     scene = SimpleNamespace(model=model, fixed=restraint_321(model), loads=self_weight(model, 1.0))
-    files = fold_outputs_hook(path, scene, tmp_path)
+    files = write_results(path, model, tmp_path, name="fold_path", fixed=scene.fixed,
+                          loads=scene.loads, npz=False, pictures=True).values()  # fmt: skip
     names = {f.name for f in files}
-    for n in ("fold_path.xdmf", "fold_path_steps.csv", "fold_path_summary.json",
+    for n in ("fold_path.xdmf", "states.csv", "summary.json",
               "fold_path.png", "fold_path_charts.png", "fold_path_0001.vtu"):  # fmt: skip
         assert n in names and (tmp_path / n).is_file()
-    summary = json.loads((tmp_path / "fold_path_summary.json").read_text())["summary"]
+    written = json.loads((tmp_path / "summary.json").read_text())
+    summary = written["results"]
     assert summary["n_free_dofs"] == model.n_dof - 6
     assert summary["effective_stiffness"] > 0
-    rows = dict(results_rows(tmp_path))
+    rows = dict(summary_rows(written))
     assert "max |bar strain|" in rows and "Gaussian curvature K (global form)" in rows
     render.can_render_offscreen.cache_clear()

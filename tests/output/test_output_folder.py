@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 import barhinge as bh
 from barhinge.cli import app
 from barhinge.errors import ConfigError
-from barhinge.io import MANIFEST, check_output_folder, read_manifest, result_folder
+from barhinge.output.folder import MANIFEST, check_output_folder, read_manifest, result_folder
 from barhinge.results import Interrupted
 
 SCENE = """name = "{name}"
@@ -184,7 +184,7 @@ def test_fold_form_only_writes_a_manifest(tmp_path):
     assert res.exit_code == 0, res.output
     man = read_manifest(out)
     assert man["kind"] == "rigid" and set(man["files"]) == {
-        "fold_path.npz", "fold_path.fold", "summary.json"}  # fmt: skip
+        "fold_path.npz", "fold_path.fold", "summary.json", "states.csv"}  # fmt: skip
 
 
 # --------------------------------------------------------------------------- Ctrl-C

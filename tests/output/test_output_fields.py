@@ -10,7 +10,9 @@ import pytest
 
 from barhinge import CreasePattern, FoldPath
 from barhinge.errors import ConfigError
-from barhinge.io import state_data, write_results
+from barhinge.output.fields import state_data
+from barhinge.output.run import write_results
+from barhinge.output.table import COLUMNS, actuator_columns
 
 
 def simple_fold_path(n_states: int = 5) -> tuple[CreasePattern, FoldPath]:
@@ -101,13 +103,15 @@ def test_csv_and_json_summaries(written):
     assert len(lines) == path.n_states + 1
     head = lines[0].split(",")
     e = int(path.actuator_edges[0])
-    assert f"fold_deg_{e}" in head and "energy_total" in head
+    assert head == list(COLUMNS) + actuator_columns([e])  # the columns of every run
     last = dict(zip(head, lines[-1].split(","), strict=True))
-    assert float(last[f"fold_deg_{e}"]) == pytest.approx(90.0)
+    assert float(last[f"actuator_{e}_fold_deg"]) == pytest.approx(90.0)
+    assert float(last[f"actuator_{e}_target_deg"]) == pytest.approx(90.0)
+    assert last["energy_total"] == ""  # NaN for a rigid path -> an empty cell
     data = json.loads(files["json"].read_text())
-    assert data["n_states"] == path.n_states and data["kind"] == "rigid"
-    assert data["final"][f"target_deg_{e}"] == pytest.approx(90.0)
-    assert data["final"]["energy_total"] is None  # NaN for a rigid path -> null
+    assert data["n_states"] == path.n_states and data["model"] == "rigid"
+    assert data["results"]["actuator_fold_deg"] == [pytest.approx(90.0)]
+    assert data["energy"]["total"] is None  # NaN for a rigid path -> null
     again = FoldPath.load(files["npz"])
     np.testing.assert_array_equal(again.X, path.X)
 
@@ -172,7 +176,7 @@ def test_write_results_of_a_bar_hinge_path(tmp_path):
     lines = (d.line_data["energy_density"] * model.bar_L0).sum()
     assert bend == pytest.approx(ev[-1].energy_bend, rel=1e-10)
     assert lines == pytest.approx(ev[-1].energy_bars + ev[-1].energy_fold, rel=1e-10)
-    summary = json.loads(files["json"].read_text())["summary"]
+    summary = json.loads(files["json"].read_text())["results"]
     assert summary["energy_total"] == pytest.approx(ev[-1].energy, rel=1e-12)
     assert summary["max_abs_bar_strain"] > 0
     if "fold" in files:

@@ -17,10 +17,10 @@ import numpy as np
 import pytest
 
 import barhinge as bh
-from barhinge.io import read_manifest
+from barhinge.output.folder import read_manifest
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_io_result_folder import miura_scene  # noqa: E402
+from test_output_folder import miura_scene  # noqa: E402
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="SIGKILL / SIGINT are POSIX")
 

@@ -1,0 +1,280 @@
+"""Fields of a state on its mesh, and the files that carry them (meshio): one ``.vtu`` per
+state and an XDMF time series of a path.
+
+Only this module imports meshio. Every file opens in ParaView / PyVista without glue:
+
+* ``<name>_NNNN.vtu``: one state; points = node coordinates; two cell blocks:
+  ``triangle`` (the panels of the triangulated sheet) and ``line`` (bars of a bar-and-hinge
+  model, or the pattern's edges for a rigid path). Arrays are listed in :func:`state_data`.
+* ``<name>.xdmf`` + ``<name>.h5`` (panels) and ``<name>_bars.xdmf`` + ``.h5`` (bars): the
+  whole path on the state-0 mesh with point data ``displacement`` per step (ParaView's
+  "Warp By Vector") and the same arrays.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from barhinge.analysis.curvature import angle_defect, mixed_voronoi_area, pattern_triangles
+from barhinge.errors import ConfigError
+from barhinge.results import FoldPath
+
+__all__ = ["StateData", "state_data", "state_mesh", "write_state_vtu", "write_xdmf"]
+
+
+class StateData:
+    """Triangles, lines and data arrays of one state (plain numpy; no meshio).
+
+    Attributes
+    ----------
+    points : (n_nodes, 3) float
+    triangles : (n_tri, 3) int
+    lines : (n_lines, 2) int
+    point_data : dict of (n_nodes, ...) arrays
+    triangle_data, line_data : dict of (n_tri,) / (n_lines,) arrays (same keys in both; NaN
+        where an array does not apply to that kind of cell)
+    """
+
+    def __init__(self, points, triangles, lines, point_data, triangle_data, line_data) -> None:
+        self.points = points
+        self.triangles = triangles
+        self.lines = lines
+        self.point_data = point_data
+        self.triangle_data = triangle_data
+        self.line_data = line_data
+
+
+def _model_triangles(hinges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Triangles of the hinges (orientation of first use) and (n_hinges, 2) triangle index of
+    each hinge's two wings."""
+    H = np.asarray(hinges, np.int64)
+    T = np.concatenate([H[:, [0, 1, 2]], H[:, [1, 0, 3]]])
+    _, first, inv = np.unique(np.sort(T, axis=1), axis=0, return_index=True, return_inverse=True)
+    order = np.argsort(first)  # unique rows in order of first use
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    tri = T[first[order]]
+    wing_tri = rank[inv.ravel()].reshape(2, len(H)).T
+    return tri, wing_tri
+
+
+def _element_energies(model: Any, X: np.ndarray, rho: np.ndarray):
+    """(n_bars,), (n_hinges,) stored energy of every bar and hinge with the model's own laws
+    (per-hinge penetration limits included); ``rho`` is unused, kept for the call sites."""
+    del rho
+    return model.element_energies(X)
+
+
+def _pair_index(pairs: np.ndarray, n: int) -> np.ndarray:
+    """Integer key of unordered node pairs."""
+    p = np.sort(np.asarray(pairs, np.int64), axis=1)
+    return p[:, 0] * n + p[:, 1]
+
+
+def state_data(
+    X: np.ndarray,
+    *,
+    model: Any | None = None,
+    pattern: Any | None = None,
+    X_ref: np.ndarray | None = None,
+    fold_angles_deg: np.ndarray | None = None,
+) -> StateData:
+    """Mesh and data arrays of one state.
+
+    Parameters
+    ----------
+    X : (n_nodes, 3) float
+        Node coordinates of the state.
+    model : BarHingeModel, optional
+        Gives triangles (from its hinges), lines (its bars), strains and energies.
+    pattern : CreasePattern, optional
+        Used without a model: fan-triangulated faces and the pattern's edges as lines.
+    X_ref : (n_nodes, 3) float, optional
+        Reference coordinates for ``displacement`` (default: ``model.X0`` or X itself).
+    fold_angles_deg : (n_edges,) float, optional
+        Fold angles per pattern edge (without a model; default: measured from X).
+
+    Arrays
+    ------
+    point data: ``displacement`` (n, 3), ``angle_defect`` (rad, NaN at the boundary),
+    ``defect_density`` (angle defect / mixed Voronoi area, 1/length^2).
+    cell data (triangle and line blocks): ``fold_angle_deg`` (lines on creases; FOLD sign),
+    ``bar_strain`` (engineering strain (L - L0)/L0 of bars), ``energy_density`` (bars and fold
+    hinges: energy per unit length; panels: bending energy per unit area; the model's own
+    laws of :mod:`barhinge.kernels.laws`), ``kind`` (0 panel, 1 bar inside a panel, 2 crease,
+    3 other pattern edge: boundary or flat line).
+    """
+    X = np.asarray(X, dtype=float)
+    if X.ndim != 2 or X.shape[1] != 3:
+        raise ConfigError(f"X must have shape (n_nodes, 3), got {X.shape}")
+    n = len(X)
+    if model is None and pattern is None:
+        raise ConfigError("state_data needs a model or a pattern to know the mesh")
+    if model is not None:
+        if model.n_nodes != n:
+            raise ConfigError(f"len(X) = {n}, but the model has {model.n_nodes} nodes")
+        tri, wing_tri = _model_triangles(model.hinges)
+        lines = np.asarray(model.bars, np.int64)
+        L = np.linalg.norm(X[lines[:, 1]] - X[lines[:, 0]], axis=1)
+        L0 = np.asarray(model.bar_L0, float)
+        eps = (L - L0) / L0
+        rho = np.asarray(model.hinge_angles(X), float)
+        e_line, e_h = _element_energies(model, X, rho)
+        e_line = e_line / L0  # energy per length
+        kind = np.asarray(model.hinge_kind)
+        fold = kind == "fold"
+        H = np.asarray(model.hinges, np.int64)
+        # fold hinges: angle and energy on the bar along their axis
+        key_line = _pair_index(lines, n)
+        fold_ang = np.full(len(lines), np.nan)
+        is_crease = np.zeros(len(lines), bool)
+        hf = np.flatnonzero(fold)
+        order = np.argsort(key_line)
+        key_h = _pair_index(H[hf, :2], n)
+        at = np.minimum(np.searchsorted(key_line[order], key_h), len(order) - 1)
+        ok = key_line[order[at]] == key_h
+        i, hf = order[at[ok]], hf[ok]
+        fold_ang[i] = np.degrees(rho[hf])
+        np.add.at(e_line, i, e_h[hf] / L0[i])
+        is_crease[i] = True
+        # bend hinges: energy split between their two triangles, per unit area
+        P = X[tri]
+        area = 0.5 * np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1)
+        bend = np.flatnonzero(~fold)
+        e_tri = np.bincount(
+            wing_tri[bend].ravel(), weights=np.repeat(0.5 * e_h[bend], 2), minlength=len(tri)
+        ) / np.where(area > 0, area, 1.0)
+        strain_line = eps
+        cp = model.pattern
+        on_edge = np.isin(key_line, _pair_index(cp.edges, n))
+        kind_line = np.where(is_crease, 2, np.where(on_edge, 3, 1))
+        Xr = model.X0 if X_ref is None else X_ref
+    else:
+        cp = pattern
+        if n < cp.n_vertices:
+            raise ConfigError(f"len(X) = {n}, but the pattern has {cp.n_vertices} vertices")
+        tri = pattern_triangles(cp)
+        lines = np.asarray(cp.edges, np.int64)
+        if fold_angles_deg is None:
+            fold_angles_deg = cp.replaced(
+                vertices=X[: cp.n_vertices], validate=False
+            ).state_fold_angles()
+        fold_ang = np.asarray(fold_angles_deg, float).copy()
+        crease = np.zeros(len(lines), bool)
+        crease[cp.crease_edges] = True
+        fold_ang[~crease] = np.nan
+        L0 = np.linalg.norm(cp.vertices3d[lines[:, 1]] - cp.vertices3d[lines[:, 0]], axis=1)
+        L = np.linalg.norm(X[lines[:, 1]] - X[lines[:, 0]], axis=1)
+        strain_line = (L - L0) / L0
+        e_line = np.full(len(lines), np.nan)
+        e_tri = np.full(len(tri), np.nan)
+        kind_line = np.where(crease, 2, 3)
+        Xr = cp.vertices3d if X_ref is None else X_ref
+    Xr = np.asarray(Xr, float)
+    disp = X - Xr if Xr.shape == X.shape else np.zeros_like(X)
+    defect = angle_defect(X, tri)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        density = defect / mixed_voronoi_area(X, tri)
+    nan_t = np.full(len(tri), np.nan)
+    return StateData(
+        points=X,
+        triangles=tri,
+        lines=lines,
+        point_data={"displacement": disp, "angle_defect": defect, "defect_density": density},
+        triangle_data={
+            "fold_angle_deg": nan_t,
+            "bar_strain": nan_t,
+            "energy_density": e_tri,
+            "kind": np.zeros(len(tri)),
+        },
+        line_data={
+            "fold_angle_deg": fold_ang,
+            "bar_strain": strain_line,
+            "energy_density": e_line,
+            "kind": kind_line.astype(float),
+        },
+    )
+
+
+def state_mesh(X: np.ndarray, **kwargs: Any):
+    """A ``meshio.Mesh`` of one state (arguments of :func:`state_data`)."""
+    import meshio
+
+    d = state_data(X, **kwargs)
+    return meshio.Mesh(
+        d.points,
+        [("triangle", d.triangles), ("line", d.lines)],
+        point_data=d.point_data,
+        cell_data={k: [d.triangle_data[k], d.line_data[k]] for k in d.triangle_data},
+    )
+
+
+def write_state_vtu(path: str | Path, X: np.ndarray, **kwargs: Any) -> Path:
+    """Write one state to a ``.vtu`` file (arguments of :func:`state_data`)."""
+    path = Path(path)
+    state_mesh(X, **kwargs).write(path)
+    return path
+
+
+@contextlib.contextmanager
+def _cwd(folder: Path) -> Iterator[None]:
+    old = Path.cwd()
+    os.chdir(folder)
+    try:
+        yield
+    finally:
+        os.chdir(old)
+
+
+def write_xdmf(
+    path: str | Path, fold_path: FoldPath, *, model: Any | None = None, pattern: Any | None = None
+) -> Path:
+    """Write a fold path as XDMF time series: ``<stem>.xdmf`` (panels, triangles) and
+    ``<stem>_bars.xdmf`` (bars or edges, lines), each with its ``.h5`` beside it.
+
+    The mesh is state 0; each step holds point data ``displacement`` (from state 0) and the
+    arrays of :func:`state_data`. The time value of step s is s.
+
+    meshio's time-series writer creates its ``.h5`` in the current directory, so it is run
+    from inside the output folder (the working directory is restored afterwards).
+    """
+    import meshio
+
+    given = Path(path)
+    path = given.resolve()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    states = [
+        state_data(
+            fold_path.X[s],
+            model=model,
+            pattern=pattern,
+            X_ref=fold_path.X[0],
+            fold_angles_deg=fold_path.fold_angles_deg[s] if model is None else None,
+        )
+        for s in range(fold_path.n_states)
+    ]
+    lines_path = path.with_name(path.stem + "_bars.xdmf")
+    d0 = states[0]
+    # meshio's XDMF writer cannot mix triangles and lines in one grid: two files
+    blocks = [
+        (path, "triangle", d0.triangles, "triangle_data"),
+        (lines_path, "line", d0.lines, "line_data"),
+    ]
+    with _cwd(path.parent):
+        for file, cell_type, conn, attr in blocks:
+            with meshio.xdmf.TimeSeriesWriter(file.name) as writer:
+                writer.write_points_cells(d0.points, [(cell_type, conn)])
+                for s, d in enumerate(states):
+                    cd = getattr(d, attr)
+                    writer.write_data(
+                        float(s),
+                        point_data=d.point_data,
+                        cell_data={k: [v] for k, v in cd.items()},
+                    )
+    return given

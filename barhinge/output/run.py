@@ -1,0 +1,260 @@
+"""One writer for the files of a fold path: the result folder of ``barhinge fold``
+(:func:`write_run`, atomic, with its manifest) and the same files into any folder
+(:func:`write_results`).
+
+A run writes ``fold_path.npz`` (the path), ``summary.json`` (one summary), ``states.csv``
+(one step table), the fields (``fold_path.xdmf``/``.h5``, ``fold_path_bars.xdmf``/``.h5``,
+``fold_path_NNNN.vtu``), FOLD frames (``fold_path.fold``), the pictures and the manifest
+``barhinge-run.json``; docs/outputs.md lists every file with its columns and units.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+import os
+from pathlib import Path
+from typing import Any
+
+from barhinge._json import jsonable
+from barhinge.errors import ConfigError
+from barhinge.output.fields import write_state_vtu, write_xdmf
+from barhinge.output.folder import MANIFEST, result_folder
+from barhinge.output.summary import run_summary, stop_reason, summary_rows
+from barhinge.output.table import step_table, write_step_table
+from barhinge.results import FoldPath
+
+__all__ = ["RunOutput", "write_results", "write_run"]
+
+log = logging.getLogger(__name__)
+
+#: the files of one run that are not optional extras
+SUMMARY, STEPS = "summary.json", "states.csv"
+
+
+@dataclasses.dataclass(frozen=True)
+class RunOutput:
+    """What a run wrote, and what the CLI prints of it.
+
+    Attributes
+    ----------
+    out : Path
+        The result folder.
+    files : list of Path
+        Every file of the run (in ``out``), the manifest last.
+    summary : dict
+        The content of ``summary.json``.
+    rows : list of (str, str)
+        (quantity, value) rows of the ``barhinge fold`` table.
+    """
+
+    out: Path
+    files: list[Path]
+    summary: dict[str, Any]
+    rows: list[tuple[str, str]]
+
+
+def _mesh_source(fold_path: FoldPath, model: Any | None, pattern: Any | None):
+    """(model, pattern) for the fields: a rigid path lives on the pattern's vertices."""
+    cp = pattern if pattern is not None else getattr(model, "pattern", None)
+    if fold_path.kind == "rigid" or model is None:
+        if cp is None:
+            raise ConfigError("writing a path without a model needs its crease pattern")
+        return None, cp
+    return model, cp
+
+
+def _write(
+    fold_path: FoldPath,
+    model: Any | None,
+    out: Path,
+    *,
+    pattern: Any | None,
+    name: str,
+    scene: Any | None,
+    vtu: str,
+    fields: bool,
+    pictures: bool,
+    npz: bool,
+    fixed: Any | None,
+    loads: Any | None,
+    results: dict | None,
+) -> tuple[dict[str, Path], dict[str, Any]]:
+    """The files of one path, written straight into ``out``; (files by kind, summary)."""
+    if vtu not in ("all", "last", "none"):
+        raise ConfigError(f"vtu = {vtu!r}; expected 'all', 'last' or 'none'")
+    model, cp = _mesh_source(fold_path, model, pattern)
+    out.mkdir(parents=True, exist_ok=True)
+    written: dict[str, Path] = {}
+    if npz:
+        written["npz"] = fold_path.save(out / f"{name}.npz")
+    if results is None:
+        from barhinge.analysis.summary import summarize
+
+        try:
+            results = summarize(fold_path, model, pattern=cp, fixed=fixed, loads=loads)
+        except Exception as exc:  # noqa: BLE001 - analysis is an extra; keep the run
+            log.warning("final-state analysis not written: %s", exc)
+            results = {}
+    summary = jsonable({**run_summary(fold_path, scene), "results": results}, nan=False)
+    written["json"] = out / SUMMARY
+    written["json"].write_text(json.dumps(summary, indent=2) + "\n")
+    written["csv"] = write_step_table(out / STEPS, step_table(fold_path, model=model, pattern=cp))
+    try:
+        written.update(_extras(fold_path, model, cp, out, name, vtu, fields, pictures))
+    except Exception as exc:  # noqa: BLE001 - an optional extra must not lose the solved path
+        log.warning("fields and pictures not all written: %s", exc)
+    return written, summary
+
+
+def _extras(fold_path, model, cp, out: Path, name: str, vtu: str, fields: bool, pictures: bool):
+    """FOLD frames, then (``fields``) XDMF and VTU files, then (``pictures``) pictures."""
+    from barhinge.pattern.fold import write_fold_path
+
+    written: dict[str, Path] = {"fold": write_fold_path(cp, fold_path, out / f"{name}.fold")}
+    if fields:
+        written["xdmf"] = write_xdmf(out / f"{name}.xdmf", fold_path, model=model, pattern=cp)
+        written["xdmf_bars"] = out / f"{name}_bars.xdmf"
+        n = fold_path.n_states
+        for s in {"all": range(n), "last": [n - 1], "none": []}[vtu]:
+            written["vtu"] = write_state_vtu(
+                out / f"{name}_{s:04d}.vtu",
+                fold_path.X[s],
+                model=model,
+                pattern=cp if model is None else None,
+                X_ref=fold_path.X[0],
+                fold_angles_deg=fold_path.fold_angles_deg[s] if model is None else None,
+            )
+    if pictures:
+        from barhinge.output.pictures import write_pictures
+
+        try:
+            written.update(write_pictures(fold_path, model, out, pattern=cp, name=name))
+        except Exception as exc:  # noqa: BLE001 - pictures are optional; never lose results
+            log.warning("pictures not written: %s", exc)
+    return written
+
+
+def write_results(
+    fold_path: FoldPath,
+    model: Any | None,
+    out_dir: str | Path,
+    *,
+    pattern: Any | None = None,
+    name: str = "result",
+    vtu: str = "all",
+    results: dict | None = None,
+    fixed: Any | None = None,
+    loads: Any | None = None,
+    npz: bool = True,
+    pictures: bool = False,
+) -> dict[str, Path]:
+    """Write the files of a fold path into ``out_dir`` as it is (created if missing; not
+    atomic: :func:`write_run` writes a whole result folder).
+
+    Parameters
+    ----------
+    fold_path : FoldPath
+    model : BarHingeModel or None
+        None for a rigid path (then ``pattern`` is required).
+    out_dir : path
+    pattern : CreasePattern, optional
+        Default ``model.pattern``.
+    name : str
+        Stem of the path's files (``<name>.npz``, ``<name>.xdmf``, ``<name>_NNNN.vtu``,
+        ``<name>.fold``); the summary and the step table are ``summary.json`` and
+        ``states.csv``.
+    vtu : {"all", "last", "none"}
+        Which states get a ``.vtu`` file.
+    results : dict, optional
+        The ``results`` record of ``summary.json``; default
+        :func:`barhinge.analysis.summary.summarize` of the path (with ``fixed`` and
+        ``loads`` for the stiffness).
+    fixed, loads : (n_nodes, 3) arrays, optional
+        Supports and load case of the scene (for the stiffness in the summary).
+    npz : bool
+        Also save the path itself (``<name>.npz``).
+    pictures : bool
+        Also draw the pictures (:func:`barhinge.output.pictures.write_pictures`).
+
+    Returns
+    -------
+    dict from a file kind (``npz``, ``json``, ``csv``, ``fold``, ``xdmf``, ``xdmf_bars``,
+    ``vtu``: the last one written, and the picture kinds) to its path.
+    """
+    files, _ = _write(fold_path, model, Path(out_dir), pattern=pattern, name=name, scene=None,
+                      vtu=vtu, fields=True, pictures=pictures, npz=npz, fixed=fixed,
+                      loads=loads, results=results)  # fmt: skip
+    return files
+
+
+def _pictures_wanted() -> bool:
+    """False when the environment sets ``BARHINGE_PICTURES=0``."""
+    if os.environ.get("BARHINGE_PICTURES", "").strip() == "0":
+        log.info("BARHINGE_PICTURES=0: no pictures")
+        return False
+    return True
+
+
+def write_run(
+    fold_path: FoldPath,
+    scene: Any,
+    out_dir: str | Path,
+    *,
+    overwrite: bool = False,
+    command: str = "fold",
+    fields: bool = True,
+    pictures: bool | None = None,
+) -> RunOutput:
+    """Write a run into the result folder ``out_dir`` atomically.
+
+    Every file goes to a temporary sibling folder that then replaces ``out_dir`` whole
+    (:func:`barhinge.output.folder.result_folder`): no stale files of an earlier run remain,
+    and a kill leaves the previous run untouched. The manifest ``barhinge-run.json`` (files,
+    scene, version, ``converged`` and ``reason``: None, ``"not converged"`` or
+    ``"interrupted"``) is written last.
+
+    Parameters
+    ----------
+    fold_path : FoldPath
+        A bar-and-hinge path (``bh.solve``) or a rigid one (``bh.rigid_fold``, on the
+        vertices of ``scene.model.pattern``).
+    scene : Scene
+        Gives the model, the supports and loads (for the stiffness in the summary).
+    overwrite : bool
+        Replace ``out_dir`` even when it is a non-empty folder that is not a result folder.
+    command : str
+        Recorded in the manifest.
+    fields : bool
+        Write the XDMF and VTU files (``fold --form-only`` does not).
+    pictures : bool, optional
+        Draw the pictures; default unless the environment sets ``BARHINGE_PICTURES=0``.
+
+    Raises
+    ------
+    ConfigError
+        ``out_dir`` is a file, or a non-empty folder that is not a barhinge result folder
+        (without ``overwrite``).
+    """
+    want_pictures = _pictures_wanted() if pictures is None else pictures
+    model = scene.model
+    with result_folder(out_dir, overwrite=overwrite, command=command) as run:
+        _, summary = _write(fold_path, model, run.path, pattern=model.pattern,
+                                  name="fold_path", scene=scene, vtu="all", fields=fields,
+                                  pictures=fields and want_pictures, npz=True,
+                                  fixed=getattr(scene, "fixed", None),
+                                  loads=getattr(scene, "loads", None), results=None)  # fmt: skip
+        run.manifest.update(
+            scene=summary["scene"],
+            kind=fold_path.kind,
+            converged=bool(fold_path.converged),
+            reason=stop_reason(fold_path),
+            message=fold_path.message,
+            n_states=int(fold_path.n_states),
+            n_nodes=int(fold_path.X.shape[1]),
+        )
+        names = sorted(p.relative_to(run.path) for p in run.path.rglob("*") if p.is_file())
+    out = Path(out_dir)
+    files = [*(out / n for n in names), out / MANIFEST]
+    return RunOutput(out, files, summary, summary_rows(summary, fold_path))

@@ -1,0 +1,180 @@
+"""The summary of a run (``summary.json``) and the lines ``barhinge fold`` prints from it.
+
+One summary for every kind of run: the run's status and totals (:func:`run_summary`, from
+the path alone) and, under ``results``, the final state's analysis
+(:func:`barhinge.analysis.summary.summarize`: curvature, strains, stiffness).
+docs/outputs.md lists the fields and their units.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from barhinge.analysis.summary import energy_split
+from barhinge.results import FoldPath
+
+__all__ = [
+    "energy_share_text",
+    "flat_start_text",
+    "run_summary",
+    "stop_reason",
+    "summary_rows",
+]
+
+
+def stop_reason(path: FoldPath) -> str | None:
+    """Why a path stopped early: None (it converged), ``"interrupted"`` (Ctrl-C) or
+    ``"not converged"``."""
+    if path.converged:
+        return None
+    return str(path.meta.get("stopped") or "not converged")
+
+
+def _finite(v: float) -> float | None:
+    return float(v) if math.isfinite(v) else None
+
+
+def run_summary(path: FoldPath, scene: Any = None) -> dict[str, Any]:
+    """Status and totals of a run, from its path alone (JSON-serialisable; NaN -> None).
+
+    ``model`` is ``"rigid"`` for a path of rigid kinematics, else ``"bar-hinge"``; the
+    energies of a rigid path are None.
+    """
+    last = path.n_states - 1
+    acts = path.actuator_edges
+    out: dict[str, Any] = {
+        "scene": path.meta.get("scene", getattr(scene, "name", "")),
+        "model": "rigid" if path.kind == "rigid" else "bar-hinge",
+        "control": path.meta.get("control", "rigid kinematics" if path.kind == "rigid" else None),
+        "converged": bool(path.converged),
+        "reason": stop_reason(path),
+        "message": path.message,
+        "n_states": int(path.n_states),
+        "n_nodes": int(path.X.shape[1]),
+        "n_dof": path.meta.get("n_dof"),
+        "linear_solver": path.meta.get("linear_solver"),
+        "wall_time_s": _finite(path.wall_time[last]) if path.n_states else 0.0,
+        "newton_iterations": int(np.sum(path.iterations)),
+        "load_factor": float(path.load_factor[last]),
+        "max_abs_fold_deg": float(np.abs(path.fold_angles_deg[last]).max(initial=0.0)),
+        "energy": {
+            "bars": _finite(path.energy_bars[last]),
+            "bend": _finite(path.energy_bend[last]),
+            "fold": _finite(path.energy_fold[last]),
+            "total": _finite(path.energy[last]),
+            "external_work": _finite(path.external_work[last]),
+        },
+        "actuators": {
+            "edges": acts.tolist(),
+            "angle_deg": path.fold_angles_deg[last][acts].tolist() if len(acts) else [],
+            "moment": [_finite(m) for m in path.actuator_moments[last].tolist()],
+        },
+        "timing": path.meta.get("timing", {}),
+        # stability events (limit points, bifurcations, negative-stiffness branches) and
+        # the work balance; see docs/solver.md
+        "events": [str(e) for e in path.meta.get("events", [])],
+        "work_balance": path.meta.get("work_balance"),
+        "reaction_sum": (
+            path.reactions[last].sum(axis=0).tolist() if path.reactions is not None else None
+        ),
+        "closure_residual": path.meta.get("max_closure"),
+    }
+    return out
+
+
+def _percent(x: float) -> str:
+    p = 100.0 * x
+    return f"{p:.1f} %" if p == 0.0 or abs(p) >= 0.1 else f"{p:.1g} %"
+
+
+def energy_share_text(path: FoldPath) -> str:
+    """The last state's energy split as one line ("folds 99.5 %, panel bending 0.4 %,
+    bars 0.1 %"); "" when the total is zero or unknown (rigid paths)."""
+    e = energy_split(path)
+    if e["energy_fraction_fold"] is None:
+        return ""
+    parts = (("folds", "fold"), ("panel bending", "bend"), ("bars", "bars"))
+    return ", ".join(f"{label} {_percent(e[f'energy_fraction_{k}'])}" for label, k in parts)
+
+
+def flat_start_text(path: FoldPath) -> str:
+    """``meta["flat_start"]`` as one line ("rigid panels, M/V assignment"); "" without it."""
+    rec = path.meta.get("flat_start")
+    if not rec:
+        return ""
+    words = [str(rec.get("predictor", "?"))]
+    if rec.get("branch"):
+        words.append(str(rec["branch"]))
+    if rec.get("mirrored"):
+        words.append("mirrored")
+    if rec.get("sign_conflicts"):
+        words.append(f"{len(rec['sign_conflicts'])} crease(s) against the branch signs")
+    return ", ".join(words)
+
+
+def summary_rows(summary: dict[str, Any], path: FoldPath | None = None) -> list[tuple[str, str]]:
+    """(quantity, value) rows of the ``barhinge fold`` table, from a summary written by
+    :func:`barhinge.output.run.write_run` (and the path, for the energy share and the flat
+    start)."""
+    rows: list[tuple[str, str]] = [("model", str(summary["model"]))]
+    if summary["model"] != "rigid":
+        rows.append(("DOF", str(summary["n_dof"])))
+    rows.append(("states", str(summary["n_states"])))
+    if summary["model"] != "rigid":
+        rows.append(("Newton iterations", str(summary["newton_iterations"])))
+    if summary["wall_time_s"] is not None:
+        rows.append(("wall time (s)", f"{summary['wall_time_s']:.2f}"))
+    if summary.get("linear_solver"):
+        rows.append(("linear solver", str(summary["linear_solver"])))
+    for k, v in summary["energy"].items():
+        if v is not None:
+            rows.append((f"energy {k}", f"{v:.6g}"))
+    if path is not None:
+        share, flat = energy_share_text(path), flat_start_text(path)
+        if share:
+            rows.append(("energy share", share))
+        if flat:
+            rows.append(("flat start", flat))
+    moments = [abs(m) for m in summary["actuators"]["moment"] if m is not None]
+    if moments:
+        rows.append(("max |actuator moment|", f"{max(moments):.6g}"))
+    if summary.get("closure_residual") is not None:
+        rows.append(("max loop-closure residual", f"{summary['closure_residual']:.2g}"))
+    rows += _results_rows(summary.get("results") or {})
+    return rows
+
+
+def _results_rows(s: dict[str, Any]) -> list[tuple[str, str]]:
+    rows: list[tuple[str, str]] = []
+
+    def add(label: str, key: str, fmt: str = "{:.4g}") -> None:
+        v = s.get(key)
+        if v is not None:
+            rows.append((label, fmt.format(v)))
+
+    act = s.get("actuator_fold_deg") or []
+    if len(act) > 4:
+        a = np.abs(act)
+        rows.append(
+            (
+                f"final |actuator fold| (deg), {len(act)} actuators",
+                f"{a.min():.2f} .. {a.max():.2f}",
+            )
+        )
+    elif act:
+        rows.append(("final actuator fold (deg)", ", ".join(f"{v:.2f}" for v in act)))
+    add("max |fold angle| (deg)", "max_abs_fold_deg", "{:.2f}")
+    add("Gaussian curvature K (global form)", "K_global")
+    add("mean curvature H (global form)", "H_global")
+    add("max |angle defect| (deg)", "max_abs_angle_defect_deg", "{:.3g}")
+    add("max |bar strain|", "max_abs_bar_strain", "{:.3g}")
+    if s.get("lowest_eigenvalues"):
+        rows.append(
+            ("lowest tangent eigenvalue (actuators released)", f"{s['lowest_eigenvalues'][0]:.4g}")
+        )
+    add("soft modes (of those computed)", "n_soft_modes", "{}")
+    add("effective stiffness (scene loads)", "effective_stiffness")
+    return rows
