@@ -427,53 +427,6 @@ def _print_events(events, to) -> None:
 # --- commands: render (results) ---
 
 
-def _pattern_for(result: Path, pattern: Path | None):
-    """The crease pattern of a saved path: ``--pattern``, else a FOLD file beside it."""
-    from barhinge.errors import ConfigError
-
-    if pattern is not None:
-        from barhinge.pattern.io import read
-
-        return read(pattern)
-    stem = result.name.removesuffix(".npz")
-    for cand in (result.with_name(f"{stem}_pattern.fold"), result.with_name(f"{stem}.fold")):
-        if cand.is_file():
-            from barhinge.pattern.fold import read_fold
-
-            return read_fold(cand, validate=False)
-    raise ConfigError(
-        f"no crease pattern for {result.name}: expected {stem}_pattern.fold or {stem}.fold "
-        "beside it, or give --pattern FILE"
-    )
-
-
-def _load_fold_path(result: Path):
-    """``FoldPath.load(result)``; a file that is not a saved fold path (empty, truncated,
-    another .npz or no .npz at all) becomes one ConfigError naming it."""
-    import pickle
-    import zipfile
-
-    from barhinge.errors import ConfigError
-    from barhinge.results import FoldPath
-
-    try:
-        return FoldPath.load(result)
-    except (
-        EOFError,  # empty file
-        zipfile.BadZipFile,  # truncated .npz
-        pickle.UnpicklingError,
-        KeyError,  # another .npz: no __json__ or a missing array
-        ValueError,  # not .npy/.npz, bad JSON, arrays of the wrong shape
-        TypeError,  # a .npy (no archive), unknown fields
-        AttributeError,
-        IndexError,
-    ) as exc:
-        why = f"{type(exc).__name__}: {_one_line(exc)}" if str(exc) else type(exc).__name__
-        raise ConfigError(
-            f"{result} is not a fold path saved by barhinge fold (.npz with __json__): {why}"
-        ) from None
-
-
 @app.command()
 def render(
     result: Annotated[Path, typer.Argument(help="Saved fold path (.npz from barhinge fold).")],
@@ -492,53 +445,10 @@ def render(
     as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
 ) -> None:
     """Re-render the pictures of a saved fold path (PNG of one state, charts, GIF)."""
-    from barhinge.errors import ConfigError
-    from barhinge.output.folder import add_to_manifest, atomic_file
-    from barhinge.plot import charts
-    from barhinge.plot import render as rnd
-    from barhinge.results import FoldPath
+    from barhinge.output.pictures import rerender
 
-    if not result.is_file():
-        what = "is a folder, not a file" if result.is_dir() else "does not exist"
-        raise ConfigError(f"result file {result} {what}")
-    fp = _load_fold_path(result)
-    cp = _pattern_for(result, pattern)
-    if fp.X.shape[1] < cp.n_vertices:
-        raise ConfigError(
-            f"the path has {fp.X.shape[1]} nodes, but the pattern has {cp.n_vertices} vertices"
-        )
-    if fp.fold_angles_deg.shape[1] != cp.n_edges:
-        raise ConfigError(
-            f"the path has fold angles of {fp.fold_angles_deg.shape[1]} edges, but the pattern "
-            f"{pattern or 'beside it'} has {cp.n_edges} edges: not the pattern of {result.name}"
-        )
-    n = fp.n_states
-    if not -n <= step < n:
-        raise ConfigError(f"--step {step} is outside the path's {n} states")
-    folder = out if out is not None else result.parent
-    if folder.exists() and not folder.is_dir():
-        raise ConfigError(f"--out {folder} is a file, not a folder")
-    folder.mkdir(parents=True, exist_ok=True)
-    stem = result.name.removesuffix(".npz")
-    s = step % n
-    X = fp.X[:, : cp.n_vertices]
-    written = {
-        "png": folder / f"{stem}_{scalars}_{s:04d}.png",
-        "charts": folder / f"{stem}_charts.png",
-    }
-    # each picture is written beside its name and renamed into place (never half a file)
-    with atomic_file(written["png"]) as tmp:
-        rnd.render_state(X[s], tmp, pattern=cp, scalars=scalars,
-                         fold_angles_deg=fp.fold_angles_deg[s], title=f"state {s} of {n - 1}",
-                         backend=backend)  # fmt: skip
-    with atomic_file(written["charts"]) as tmp:
-        charts.summary_figure(fp, tmp)
-    if gif and n > 1:
-        fp_v = FoldPath(X=X, fold_angles_deg=fp.fold_angles_deg, kind=fp.kind)
-        written["gif"] = folder / f"{stem}.gif"
-        with atomic_file(written["gif"]) as tmp:
-            rnd.animate(fp_v, tmp, pattern=cp, scalars=scalars, backend=backend)
-    add_to_manifest(folder, list(written.values()))  # a result folder lists them as its own
+    written = rerender(result, out=out, pattern=pattern, scalars=scalars, step=step, gif=gif,
+                       backend=backend)  # fmt: skip
     if as_json:
         print_json({k: str(v) for k, v in written.items()})
     else:
