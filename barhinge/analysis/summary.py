@@ -1,5 +1,5 @@
 """One flat record of a fold path's final state: the numbers ``barhinge fold`` prints and
-writes into ``<name>_summary.json``."""
+writes under ``results`` in ``summary.json`` (:mod:`barhinge.output.summary`)."""
 
 from __future__ import annotations
 
