@@ -116,6 +116,7 @@ def state_data(
     n = len(X)
     if model is None and pattern is None:
         raise ConfigError("state_data needs a model or a pattern to know the mesh")
+    cp: Any = pattern  # a model or a pattern: checked above
     if model is not None:
         if model.n_nodes != n:
             raise ConfigError(f"len(X) = {n}, but the model has {model.n_nodes} nodes")

@@ -45,6 +45,18 @@ def run_summary(path: FoldPath, scene: Any = None) -> dict[str, Any]:
     """
     last = path.n_states - 1
     acts = path.actuator_edges
+    # FoldPath fills every per-state array in __post_init__ (NaN where unknown)
+    wall, iters, lam = (np.asarray(a) for a in (path.wall_time, path.iterations, path.load_factor))
+    e_bars, e_bend, e_fold, work, moments = (
+        np.asarray(a)
+        for a in (
+            path.energy_bars,
+            path.energy_bend,
+            path.energy_fold,
+            path.external_work,
+            path.actuator_moments,
+        )
+    )
     out: dict[str, Any] = {
         "scene": path.meta.get("scene", getattr(scene, "name", "")),
         "model": "rigid" if path.kind == "rigid" else "bar-hinge",
@@ -56,21 +68,21 @@ def run_summary(path: FoldPath, scene: Any = None) -> dict[str, Any]:
         "n_nodes": int(path.X.shape[1]),
         "n_dof": path.meta.get("n_dof"),
         "linear_solver": path.meta.get("linear_solver"),
-        "wall_time_s": _finite(path.wall_time[last]) if path.n_states else 0.0,
-        "newton_iterations": int(np.sum(path.iterations)),
-        "load_factor": float(path.load_factor[last]),
+        "wall_time_s": _finite(wall[last]) if path.n_states else 0.0,
+        "newton_iterations": int(np.sum(iters)),
+        "load_factor": float(lam[last]),
         "max_abs_fold_deg": float(np.abs(path.fold_angles_deg[last]).max(initial=0.0)),
         "energy": {
-            "bars": _finite(path.energy_bars[last]),
-            "bend": _finite(path.energy_bend[last]),
-            "fold": _finite(path.energy_fold[last]),
-            "total": _finite(path.energy[last]),
-            "external_work": _finite(path.external_work[last]),
+            "bars": _finite(e_bars[last]),
+            "bend": _finite(e_bend[last]),
+            "fold": _finite(e_fold[last]),
+            "total": _finite(e_bars[last] + e_bend[last] + e_fold[last]),
+            "external_work": _finite(work[last]),
         },
         "actuators": {
             "edges": acts.tolist(),
             "angle_deg": path.fold_angles_deg[last][acts].tolist() if len(acts) else [],
-            "moment": [_finite(m) for m in path.actuator_moments[last].tolist()],
+            "moment": [_finite(m) for m in moments[last].tolist()],
         },
         "timing": path.meta.get("timing", {}),
         # stability events (limit points, bifurcations, negative-stiffness branches) and
@@ -94,10 +106,9 @@ def energy_share_text(path: FoldPath) -> str:
     """The last state's energy split as one line ("folds 99.5 %, panel bending 0.4 %,
     bars 0.1 %"); "" when the total is zero or unknown (rigid paths)."""
     e = energy_split(path)
-    if e["energy_fraction_fold"] is None:
-        return ""
     parts = (("folds", "fold"), ("panel bending", "bend"), ("bars", "bars"))
-    return ", ".join(f"{label} {_percent(e[f'energy_fraction_{k}'])}" for label, k in parts)
+    shares = [(label, e[f"energy_fraction_{k}"]) for label, k in parts]
+    return ", ".join(f"{label} {_percent(x)}" for label, x in shares if x is not None)
 
 
 def flat_start_text(path: FoldPath) -> str:

@@ -73,14 +73,14 @@ def step_table(
     )
     cols: dict[str, np.ndarray] = {
         "state": np.arange(n),
-        "load_factor": fold_path.load_factor,
-        "iterations": fold_path.iterations,
-        "wall_time_s": fold_path.wall_time,
+        "load_factor": np.asarray(fold_path.load_factor),
+        "iterations": np.asarray(fold_path.iterations),
+        "wall_time_s": np.asarray(fold_path.wall_time),
         "energy_total": fold_path.energy,
-        "energy_fold": fold_path.energy_fold,
-        "energy_bend": fold_path.energy_bend,
-        "energy_bars": fold_path.energy_bars,
-        "external_work": fold_path.external_work,
+        "energy_fold": np.asarray(fold_path.energy_fold),
+        "energy_bend": np.asarray(fold_path.energy_bend),
+        "energy_bars": np.asarray(fold_path.energy_bars),
+        "external_work": np.asarray(fold_path.external_work),
         "reaction_x": R[:, 0],
         "reaction_y": R[:, 1],
         "reaction_z": R[:, 2],
@@ -106,9 +106,9 @@ def step_table(
             if cp is not None and cp.n_faces >= 6:
                 cols["K_global"][s] = fit_quadratic(reference_points(fold_path.X[s], cp)).K
     for a, e in enumerate(act):
-        cols[f"actuator_{int(e)}_target_deg"] = fold_path.actuator_targets_deg[:, a]
+        cols[f"actuator_{int(e)}_target_deg"] = np.asarray(fold_path.actuator_targets_deg)[:, a]
         cols[f"actuator_{int(e)}_fold_deg"] = fold_path.fold_angles_deg[:, e]
-        cols[f"actuator_{int(e)}_moment"] = fold_path.actuator_moments[:, a]
+        cols[f"actuator_{int(e)}_moment"] = np.asarray(fold_path.actuator_moments)[:, a]
     ints = ("state", "iterations")
     return [
         {k: (int(v[s]) if k in ints else float(v[s])) for k, v in cols.items()} for s in range(n)

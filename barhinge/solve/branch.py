@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from barhinge._typing import SolverModel
 from barhinge.actuators import Actuators
 from barhinge.errors import BarhingeError, ConvergenceError
 from barhinge.kinematics.path import RigidOptions, rigid_fold
@@ -45,13 +46,13 @@ log = logging.getLogger(__name__)
 FLAT_START_TOL = 1e-6
 
 
-def is_flat(model: Any) -> bool:
+def is_flat(model: SolverModel) -> bool:
     """True when every fold hinge of ``model`` is flat in its reference state."""
     rest = np.asarray(model.rest_angle)[np.asarray(model.hinge_kind) == "fold"]
     return bool(rest.size) and float(np.max(np.abs(rest))) < FLAT_START_TOL
 
 
-def fold_weights(model: Any) -> tuple[np.ndarray, float]:
+def fold_weights(model: SolverModel) -> tuple[np.ndarray, float]:
     """(n_edges,) fold-spring stiffness per pattern edge (1 where no fold hinge) and the
     median bending-hinge stiffness (for triangulated panels)."""
     kind = np.asarray(model.hinge_kind)
@@ -64,7 +65,7 @@ def fold_weights(model: Any) -> tuple[np.ndarray, float]:
     return w, kb
 
 
-def _node_coordinates(model: Any, V: np.ndarray) -> np.ndarray:
+def _node_coordinates(model: SolverModel, V: np.ndarray) -> np.ndarray:
     """(n_nodes, 3) model nodes from pattern vertices ``V``: centre nodes at the mean of
     their face's corners."""
     cp = model.pattern
@@ -144,7 +145,7 @@ class RigidGuide:
 
 
 def rigid_guide(
-    model: Any,
+    model: SolverModel,
     actuators: Actuators,
     steps: int,
     fixed: np.ndarray,
@@ -213,7 +214,7 @@ def rigid_guide(
 
 
 def creases_against_assignment(
-    model: Any, fold_deg: np.ndarray, mirrored: bool = False, min_deg: float = 1.0
+    model: SolverModel, fold_deg: np.ndarray, mirrored: bool = False, min_deg: float = 1.0
 ) -> list[int]:
     """Pattern edges assigned M or V whose fold angle ``fold_deg`` (n_edges,) degrees has the
     other sign by more than ``min_deg`` (signs flipped as a whole when ``mirrored``)."""

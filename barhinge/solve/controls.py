@@ -41,6 +41,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from barhinge._typing import SolverModel
 from barhinge.linalg.backends import LinearBackend, SingularMatrixError
 
 __all__ = ["ActuatorTerms", "BorderedSystem", "Timer", "actuator_terms", "hinge_derivatives"]
@@ -63,7 +64,7 @@ class Timer:
         return dataclasses.asdict(self)
 
 
-def hinge_derivatives(model: Any, X: np.ndarray, hinge_ids: np.ndarray):
+def hinge_derivatives(model: SolverModel, X: np.ndarray, hinge_ids: np.ndarray):
     """(rho, grad, hess) of the given hinges: (na,), (na, 12), (na, 12, 12)."""
     if hasattr(model, "hinge_angle_derivatives"):
         return model.hinge_angle_derivatives(X, hinge_ids)
@@ -87,7 +88,7 @@ class ActuatorTerms:
     dofs: np.ndarray
 
 
-def actuator_terms(model: Any, X: np.ndarray, hinge_ids: np.ndarray) -> ActuatorTerms:
+def actuator_terms(model: SolverModel, X: np.ndarray, hinge_ids: np.ndarray) -> ActuatorTerms:
     """Angles, constraint Jacobian and Hessians of the actuator hinges at ``X``."""
     n_dof = 3 * len(X)
     na = len(hinge_ids)

@@ -7,25 +7,27 @@ Rigid kinematics is exact and fastest for a form driven by actuators alone
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Literal
 
 import numpy as np
 
+from barhinge.errors import ConfigError
 from barhinge.results import FoldPath
+from barhinge.scene import Scene
 
 __all__ = ["form_only_model", "rigid_form"]
 
 
-def form_only_model(scene: Any) -> tuple[Literal["rigid", "bar-hinge"], str]:
+def form_only_model(scene: Scene) -> tuple[Literal["rigid", "bar-hinge"], str]:
     """("rigid" | "bar-hinge", reason): the model ``scene`` needs for its folded form."""
     if scene.actuators is None or not scene.actuators.n:
         return "bar-hinge", "no actuators"
-    if np.any(scene.loads) or np.isfinite(scene.prescribed).any():
+    if np.any(scene.loads) or np.isfinite(np.asarray(scene.prescribed, float)).any():
         return "bar-hinge", "the scene has loads or prescribed displacements"
     return "rigid", "actuators only"
 
 
-def rigid_form(scene: Any) -> FoldPath:
+def rigid_form(scene: Scene) -> FoldPath:
     """Fold ``scene`` by rigid kinematics, free motions resolved with the model's own fold
     springs (its rigid limit); a path on the vertices of ``scene.model.pattern``.
 
@@ -37,6 +39,9 @@ def rigid_form(scene: Any) -> FoldPath:
     """
     from barhinge.kinematics.path import RigidOptions, rigid_fold
     from barhinge.solve.branch import fold_weights
+
+    if scene.actuators is None:
+        raise ConfigError("rigid kinematics folds a scene by its actuators; this one has none")
 
     # no DOF recount per state (a diagnostic that costs a dense SVD per state)
     opts = RigidOptions(max_cutbacks=3, check_rank=False, over_actuated="error")
