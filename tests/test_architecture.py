@@ -39,6 +39,7 @@ LAYERS: list[tuple[str, list[str]]] = [
             "barhinge._check",
             "barhinge._version",
             "barhinge._json",
+            "barhinge._protocols",
         ],
     ),
     ("linalg", ["barhinge.linalg", "barhinge.linalg.*"]),

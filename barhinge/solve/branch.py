@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from barhinge._typing import SolverModel
+from barhinge._protocols import SolverModel
 from barhinge.actuators import Actuators
 from barhinge.errors import BarhingeError, ConvergenceError
 from barhinge.kinematics.path import RigidOptions, rigid_fold

@@ -41,7 +41,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from barhinge._typing import SolverModel
+from barhinge._protocols import SolverModel
 from barhinge.linalg.backends import LinearBackend, SingularMatrixError
 
 __all__ = ["ActuatorTerms", "BorderedSystem", "Timer", "actuator_terms", "hinge_derivatives"]

@@ -1,4 +1,4 @@
-"""The model the solver needs (``barhinge._typing.SolverModel``): the bar-and-hinge model is
+"""The model the solver needs (``barhinge._protocols.SolverModel``): the bar-and-hinge model is
 one, and an object that lacks a member the solver reads is not."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import dataclasses
 
 import barhinge as bh
-from barhinge._typing import SolverModel
+from barhinge._protocols import SolverModel
 
 
 def test_bar_hinge_model_is_a_solver_model():
