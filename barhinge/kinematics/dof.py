@@ -34,6 +34,7 @@ import scipy.sparse as sp
 from barhinge.errors import ConfigError, PatternError
 from barhinge.kinematics.constraints import RigidConstraints
 from barhinge.linalg.nullspace import DENSE_LIMIT, NullSpace, RankError, null_space
+from barhinge.linalg.threads import single_threaded_dense
 from barhinge.pattern.crease import CreasePattern
 
 __all__ = ["DofReport", "dof", "select_actuators", "folded_sample"]
@@ -165,6 +166,7 @@ class DofReport:
 
 
 # ------------------------------------------------------------------------- public API
+@single_threaded_dense
 def dof(
     cp: CreasePattern,
     state: np.ndarray | Sequence[float] | None = None,

@@ -49,6 +49,7 @@ from barhinge.kinematics.constraints import RigidConstraints
 from barhinge.kinematics.dof import FLAT_TOL, _branch_direction
 from barhinge.linalg.backends import SingularMatrixError, get_backend
 from barhinge.linalg.nullspace import DENSE_TOL, null_space
+from barhinge.linalg.threads import single_threaded_dense
 from barhinge.pattern.crease import CreasePattern
 from barhinge.results import FoldPath
 
@@ -637,6 +638,7 @@ def _as_actuators(actuators: Actuators | Sequence[int], targets_deg) -> Actuator
     return Actuators(edges=list(actuators), targets_deg=targets_deg)
 
 
+@single_threaded_dense
 def rigid_fold(
     cp: CreasePattern,
     actuators: Actuators | Sequence[int],

@@ -21,6 +21,7 @@ import numpy as np
 
 from barhinge.errors import ConfigError, ConvergenceError
 from barhinge.linalg.backends import SingularMatrixError, get_backend
+from barhinge.linalg.threads import threads_for_sparse
 from barhinge.results import FoldPath, Interrupted
 from barhinge.solve.branch import RigidGuide, creases_against_assignment, is_flat, rigid_guide
 from barhinge.solve.controls import (
@@ -1039,6 +1040,7 @@ class _Driver:
             it += 1
 
 
+@threads_for_sparse
 def solve(scene: Scene, progress: Progress | None = None) -> FoldPath:
     """Solve a scene along its path; returns a :class:`~barhinge.results.FoldPath`.
 
