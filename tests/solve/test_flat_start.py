@@ -157,3 +157,39 @@ def test_underactuated_resch_converges_to_the_energy_minimising_rigid_fold(n, k)
         errs.append(np.abs(fp.fold_angles_deg[-1] - rigid.fold_angles_deg[-1]).max())
     slope = np.polyfit(np.log(ratios), np.log(errs), 1)[0]
     assert abs(slope + 1.0) < 0.15, (errs, slope)
+
+
+@pytest.mark.parametrize("k", [2, 3])
+def test_yoshimura_from_flat_folds_with_the_assignment_and_reaches_the_rigid_fold(k):
+    """A Yoshimura sheet (one cell wide, two rows: 3 rigid DOF) driven from flat by 2 or 3
+    of the actuators bh.dof suggests, README workflow: every crease folds with its
+    assignment's sign and the fold angles approach the energy-minimising rigid fold
+    (bh.rigid_fold with the model's fold stiffnesses; with 2 actuators one free motion is
+    resolved by the fold springs) as 1/ratio: log-log slope -1 +- 0.15 over three decades.
+    Tight force tolerances: the gap is ~1e-6 deg at ratio 1e6."""
+    from barhinge.solve.branch import fold_weights
+
+    cp = bh.patterns.yoshimura(1, 2)
+    rep = bh.dof(cp)
+    assert rep.mechanism.global_dof == 3
+    a = [int(e) for e in rep.mechanism.actuators][:k]
+    targets = 0.5 * cp.fold_angles[a]
+    ratios = np.array([1e4, 1e5, 1e6])
+    errs = []
+    for ratio in ratios:
+        model = bh.BarHingeModel.from_pattern(
+            cp, scheme="N5B8", material=MAT, stiffness_ratio=ratio
+        )
+        w, _ = fold_weights(model)
+        rigid = bh.rigid_fold(cp, a, targets_deg=targets, steps=5, fold_stiffness=w)
+        assert rigid.meta["free_dof"] == 3 - k
+        assert len(_against(cp, rigid.fold_angles_deg[-1])) == 0
+        acts = bh.Actuators(edges=a, targets_deg=targets)
+        opts = {"tol_force": 1e-13, "tol_disp": 1e-13}
+        fp = bh.solve(bh.Scene(model, actuators=acts, steps=5, options=opts))
+        assert fp.converged
+        assert len(_against(cp, fp.fold_angles_deg[-1])) == 0
+        assert fp.meta["branch_events"] == []
+        errs.append(np.abs(fp.fold_angles_deg[-1] - rigid.fold_angles_deg[-1]).max())
+    slope = np.polyfit(np.log(ratios), np.log(errs), 1)[0]
+    assert abs(slope + 1.0) < 0.15, (errs, slope)
