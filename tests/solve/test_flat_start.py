@@ -193,3 +193,38 @@ def test_yoshimura_from_flat_folds_with_the_assignment_and_reaches_the_rigid_fol
         errs.append(np.abs(fp.fold_angles_deg[-1] - rigid.fold_angles_deg[-1]).max())
     slope = np.polyfit(np.log(ratios), np.log(errs), 1)[0]
     assert abs(slope + 1.0) < 0.15, (errs, slope)
+
+
+def test_conflicting_actuators_of_a_folded_start_are_named_before_solving(caplog):
+    """A folded Miura 3 x 3 (one rigid DOF, checked by a dense SVD of the loop-closure
+    Jacobian) driven by two zig-zag creases: targets taken from the rigid fold of one of
+    them are compatible (no event); moving the second the other way conflicts, and the run
+    names the dependent actuator in a warning logged before the first increment and in its
+    events."""
+    import logging
+
+    from barhinge.kinematics.constraints import RigidConstraints
+
+    cp = bh.patterns.miura(3, 3, alpha=60.0, fold=30.0)
+    rc = RigidConstraints.from_pattern(cp)
+    sv = np.linalg.svd(rc.jacobian(rc.rho0).toarray(), compute_uv=False)
+    assert rc.n_var - np.sum(sv > 1e-9 * sv[0]) == 1
+    z1, z2 = (int(e) for e in bh.patterns.miura_layout(3, 3).interior_zigzag_edges[:2])
+    ref = bh.rigid_fold(cp, [z1], targets_deg=[cp.fold_angles[z1] * 1.2], steps=4)
+    model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=MAT, stiffness_ratio=1e4)
+
+    good = bh.Actuators(edges=[z1, z2], targets_deg=ref.fold_angles_deg[-1, [z1, z2]])
+    fp = bh.solve(bh.Scene(model, actuators=good, steps=4))
+    assert fp.converged and not any("conflict" in ev for ev in fp.meta["events"])
+
+    bad_t = [ref.fold_angles_deg[-1, z1], cp.fold_angles[z2] * 0.8]
+    bad = bh.Actuators(edges=[z1, z2], targets_deg=bad_t)
+    with caplog.at_level(logging.WARNING):
+        fp = bh.solve(bh.Scene(model, actuators=bad, steps=4))
+    named = [ev for ev in fp.meta["events"] if "actuator targets conflict" in ev]
+    assert len(named) == 1
+    assert f"edges [{z2}] follow from edges [{z1}]" in named[0] or (
+        f"edges [{z1}] follow from edges [{z2}]" in named[0]
+    )
+    first = next(i for i, r in enumerate(caplog.records) if "conflict" in r.getMessage())
+    assert first == 0  # before anything the solve logs about its increments
