@@ -159,38 +159,55 @@ def test_underactuated_resch_converges_to_the_energy_minimising_rigid_fold(n, k)
     assert abs(slope + 1.0) < 0.15, (errs, slope)
 
 
-@pytest.mark.parametrize("k", [2, 3])
-def test_yoshimura_from_flat_folds_with_the_assignment_and_reaches_the_rigid_fold(k):
-    """A Yoshimura sheet (one cell wide, two rows: 3 rigid DOF) driven from flat by 2 or 3
-    of the actuators bh.dof suggests, README workflow: every crease folds with its
-    assignment's sign and the fold angles approach the energy-minimising rigid fold
-    (bh.rigid_fold with the model's fold stiffnesses; with 2 actuators one free motion is
-    resolved by the fold springs) as 1/ratio: log-log slope -1 +- 0.15 over three decades.
-    Tight force tolerances: the gap is ~1e-6 deg at ratio 1e6."""
+def _readme_gap(cp, k, ratios, steps=5):
+    """The README workflow from the flat state: the first ``k`` actuators bh.dof suggests,
+    driven to half the pattern's target fold angles, default solver options. Checks that
+    the rigid fold (bh.rigid_fold with the model's fold stiffnesses) and the bar-and-hinge
+    fold both fold every crease with its assignment; returns the largest fold-angle gap
+    (deg) between them per stiffness ratio."""
     from barhinge.solve.branch import fold_weights
 
-    cp = bh.patterns.yoshimura(1, 2)
-    rep = bh.dof(cp)
-    assert rep.mechanism.global_dof == 3
-    a = [int(e) for e in rep.mechanism.actuators][:k]
+    a = [int(e) for e in bh.dof(cp).mechanism.actuators][:k]
     targets = 0.5 * cp.fold_angles[a]
-    ratios = np.array([1e4, 1e5, 1e6])
     errs = []
     for ratio in ratios:
         model = bh.BarHingeModel.from_pattern(
             cp, scheme="N5B8", material=MAT, stiffness_ratio=ratio
         )
         w, _ = fold_weights(model)
-        rigid = bh.rigid_fold(cp, a, targets_deg=targets, steps=5, fold_stiffness=w)
-        assert rigid.meta["free_dof"] == 3 - k
+        rigid = bh.rigid_fold(cp, a, targets_deg=targets, steps=steps, fold_stiffness=w)
         assert len(_against(cp, rigid.fold_angles_deg[-1])) == 0
         acts = bh.Actuators(edges=a, targets_deg=targets)
-        opts = {"tol_force": 1e-13, "tol_disp": 1e-13}
-        fp = bh.solve(bh.Scene(model, actuators=acts, steps=5, options=opts))
+        fp = bh.solve(bh.Scene(model, actuators=acts, steps=steps))
         assert fp.converged
         assert len(_against(cp, fp.fold_angles_deg[-1])) == 0
         assert fp.meta["branch_events"] == []
         errs.append(np.abs(fp.fold_angles_deg[-1] - rigid.fold_angles_deg[-1]).max())
+    return np.asarray(errs), rigid
+
+
+@pytest.mark.parametrize(
+    "name, cp, k, ratios",
+    [
+        ("miura 4x4", bh.patterns.miura(nx=4, ny=4, a=1.0, b=1.0, alpha=60.0), 1, (1e3, 1e4, 1e5)),
+        ("yoshimura 1x2", bh.patterns.yoshimura(1, 2), 2, (1e4, 1e5, 1e6)),
+        ("yoshimura 1x2", bh.patterns.yoshimura(1, 2), 3, (1e4, 1e5, 1e6)),
+        ("resch 3x3", bh.patterns.resch(3, 3), 3, (1e3, 1e4, 1e5)),
+    ],
+    ids=["miura4-1", "yoshimura-2", "yoshimura-3", "resch-3"],
+)
+def test_readme_workflow_from_flat_reaches_the_rigid_fold(name, cp, k, ratios):
+    """From the flat state with the README workflow (bh.dof's actuators, default options):
+    every crease folds with its assignment's sign and the fold angles approach the
+    energy-minimising rigid fold as 1/ratio, log-log slope -1 +- 0.15 over three decades.
+    The Yoshimura sheet (one cell wide, two rows: 3 rigid DOF) with 2 actuators leaves one
+    free motion to the fold springs in both solvers. Larger under-actuated Yoshimura sheets
+    have several strict energy minima (tests/kinematics/test_kin_energy.py), so their
+    rigid limit is not unique (docs/solver.md)."""
+    ratios = np.asarray(ratios)
+    errs, rigid = _readme_gap(cp, k, ratios)
+    if name.startswith("yoshimura"):
+        assert bh.dof(cp).mechanism.global_dof == 3 and rigid.meta["free_dof"] == 3 - k
     slope = np.polyfit(np.log(ratios), np.log(errs), 1)[0]
     assert abs(slope + 1.0) < 0.15, (errs, slope)
 
