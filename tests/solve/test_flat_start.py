@@ -193,8 +193,9 @@ def _readme_gap(cp, k, ratios, steps=5):
         ("yoshimura 1x2", bh.patterns.yoshimura(1, 2), 2, (1e4, 1e5, 1e6)),
         ("yoshimura 1x2", bh.patterns.yoshimura(1, 2), 3, (1e4, 1e5, 1e6)),
         ("resch 3x3", bh.patterns.resch(3, 3), 3, (1e3, 1e4, 1e5)),
+        ("waterbomb 1x1", bh.patterns.waterbomb(1, 1), 3, (1e3, 1e4, 1e5)),
     ],
-    ids=["miura4-1", "yoshimura-2", "yoshimura-3", "resch-3"],
+    ids=["miura4-1", "yoshimura-2", "yoshimura-3", "resch-3", "waterbomb-3"],
 )
 def test_readme_workflow_from_flat_reaches_the_rigid_fold(name, cp, k, ratios):
     """From the flat state with the README workflow (bh.dof's actuators, default options):
