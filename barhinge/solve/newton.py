@@ -23,7 +23,13 @@ from barhinge.errors import ConfigError, ConvergenceError
 from barhinge.linalg.backends import SingularMatrixError, get_backend
 from barhinge.linalg.threads import threads_for_sparse
 from barhinge.results import FoldPath, Interrupted
-from barhinge.solve.branch import RigidGuide, creases_against_assignment, is_flat, rigid_guide
+from barhinge.solve.branch import (
+    RigidGuide,
+    conflicting_actuators,
+    creases_against_assignment,
+    is_flat,
+    rigid_guide,
+)
 from barhinge.solve.controls import (
     BorderedSystem,
     Timer,
@@ -134,6 +140,14 @@ class _Driver:
         self._flat_start = bool(self.n_act and self.opts.flat_start == "rigid" and is_flat(model))
         self.flat_start_record: dict[str, Any] | None = None
         self._guide: RigidGuide | None = None
+        # a folded start: conflicting actuators are named before solving (flat starts: by
+        # the rigid predictor)
+        clash = (
+            None if self._flat_start else conflicting_actuators(model, scene.actuators, scene.steps)
+        )
+        self._start_events = [clash] if clash else []
+        for ev in self._start_events:
+            log.warning("%s: %s", scene.name or "solve", ev)
         # stability monitoring: inertia of the free-DOF tangent at every recorded state
         self.exact_inertia = self.opts.exact_inertia(scene.control)
         self._inc_serial = 0  # factorisations made before the current increment
@@ -354,7 +368,7 @@ class _Driver:
         that fold against their M/V assignment."""
         rec = self.flat_start_record
         if not self.records or not (self.n_act and is_flat(self.model)):
-            return []
+            return list(self._start_events)
         rec = rec or {}
         events = list(rec.get("events", []))
         bad = creases_against_assignment(
