@@ -43,7 +43,7 @@ import scipy.sparse.linalg as spla
 
 from barhinge.errors import ConfigError
 
-__all__ = ["PeriodicCell", "periodic_cell"]
+__all__ = ["PeriodicCell", "kinematic_abd", "periodic_cell"]
 
 #: names of the six macroscopic components, in the order of ``PeriodicCell.ABD``
 COMPONENTS = ("eps_11", "eps_22", "gamma_12", "kappa_11", "kappa_22", "kappa_12x2")
@@ -145,6 +145,28 @@ def _frame(lattice: np.ndarray) -> np.ndarray:
     return np.vstack([e1, np.cross(n, e1), n])
 
 
+def _macro_field(X: np.ndarray, R: np.ndarray, z0: float) -> np.ndarray:
+    """(n, 3, 6) displacement of every node (global axes) for a unit value of each
+    macroscopic component (frame rows ``R``; in-plane origin at the centroid, ``z`` from the
+    plane ``z0``)."""
+    p = (X - X.mean(0)) @ R.T
+    x, y = p[:, 0], p[:, 1]
+    z = X @ R[2] - z0
+    o = np.zeros_like(x)
+    loc = np.stack(
+        [
+            np.stack([x, o, o], 1),  # eps_11
+            np.stack([o, y, o], 1),  # eps_22
+            np.stack([y / 2, x / 2, o], 1),  # gamma_12
+            np.stack([-z * x, o, x * x / 2], 1),  # kappa_11
+            np.stack([o, -z * y, y * y / 2], 1),  # kappa_22
+            np.stack([-z * y / 2, -z * x / 2, x * y / 2], 1),  # 2 kappa_12
+        ],
+        axis=2,
+    )  # (n, 3, 6) in the frame
+    return np.einsum("ai,nag->nig", R, loc)
+
+
 def _node_classes(X: np.ndarray, lattice: np.ndarray, tol: float):
     """Class id and integer cell index (n, 2) of each node: nodes whose positions differ by
     an integer combination of the lattice vectors share a class."""
@@ -236,7 +258,8 @@ def periodic_cell(
     X : (n_nodes, 3) float, optional
         State (default ``model.X0``).
     z0 : float, optional
-        Reference plane of the curvatures (frame z; default the mean over node classes).
+        Reference plane of the curvatures: its ``n`` coordinate (``X @ n``; default the mean
+        over node classes).
     tol : float
         Relative tolerance of the periodic node matching.
 
@@ -282,24 +305,9 @@ def periodic_cell(
     cell = model.with_(bar_EA=model.bar_EA * wb, hinge_k=model.hinge_k * wh)
     K = sp.csr_matrix(cell.tangent(X))
 
-    # macroscopic field in the cell frame, rotated to global axes
-    p = (X - X.mean(0)) @ R.T
-    zc = np.array([p[cls == c, 2].mean() for c in range(n_cls)])
-    z = p[:, 2] - (zc.mean() if z0 is None else z0 - (X.mean(0) @ R[2]))
-    x, y = p[:, 0], p[:, 1]
-    o = np.zeros_like(x)
-    loc = np.stack(
-        [
-            np.stack([x, o, o], 1),  # eps_11
-            np.stack([o, y, o], 1),  # eps_22
-            np.stack([y / 2, x / 2, o], 1),  # gamma_12
-            np.stack([-z * x, o, x * x / 2], 1),  # kappa_11
-            np.stack([o, -z * y, y * y / 2], 1),  # kappa_22
-            np.stack([-z * y / 2, -z * x / 2, x * y / 2], 1),  # 2 kappa_12
-        ],
-        axis=2,
-    )  # (n, 3, 6) in the frame
-    Phi_n = np.einsum("ai,nag->nig", R, loc)  # global axes
+    zc = float((np.bincount(cls, X @ R[2]) / np.bincount(cls)).mean())
+    z_ref = zc if z0 is None else float(z0)
+    Phi_n = _macro_field(X, R, z_ref)
     Phi = Phi_n.reshape(-1, 6)
     # periodic fluctuation: node dof (3 n + a) <- class dof (3 c + a); class 0 fixed
     rows = np.arange(3 * len(X))
@@ -325,9 +333,46 @@ def periodic_cell(
         ABD=ABD,
         frame=R,
         area=area,
-        z0=float(zc.mean() + X.mean(0) @ R[2] if z0 is None else z0),
+        z0=z_ref,
         classes=cls,
         weights_bars=wb,
         weights_hinges=wh,
         modes=modes,
     )
+
+
+def kinematic_abd(
+    model: Any,
+    area: float,
+    frame: np.ndarray,
+    z0: float,
+    X: np.ndarray | None = None,
+    boundary: np.ndarray | None = None,
+) -> np.ndarray:
+    """(6, 6) ``ABD`` of a finite sheet with the macroscopic field prescribed on its boundary
+    nodes and the others free (kinematic uniform boundary conditions): the condensed tangent
+    divided by ``area``. An upper bound of the periodic ``ABD`` (Hill 1963) that closes as
+    the sheet grows.
+
+    Parameters
+    ----------
+    model : BarHingeModel of the sheet
+    area : float
+        Projected area the sheet stands for (e.g. cells x ``PeriodicCell.area``).
+    frame, z0 : as in :class:`PeriodicCell` (use the cell's, to compare).
+    X : (n_nodes, 3) float, optional (default ``model.X0``)
+    boundary : (k,) int, optional
+        Nodes that follow the macroscopic field (default the pattern's boundary vertices).
+    """
+    X = model.X0 if X is None else np.asarray(X, float)
+    bnd = model.pattern.boundary_vertices if boundary is None else np.asarray(boundary, int)
+    if len(bnd) == 0:
+        raise ConfigError("kinematic_abd needs boundary nodes")
+    K = sp.csr_matrix(model.tangent(X))
+    Phi = _macro_field(X, np.asarray(frame, float), float(z0)).reshape(-1, 6)
+    free = np.ones(len(X), bool)
+    free[bnd] = False
+    f = np.flatnonzero(np.repeat(free, 3))
+    KP = np.asarray((K @ Phi)[f])
+    Keff = Phi.T @ (K @ Phi) - KP.T @ spla.splu(K[f][:, f].tocsc()).solve(KP)
+    return 0.5 * (Keff + Keff.T) / float(area)

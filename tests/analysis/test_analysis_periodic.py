@@ -139,3 +139,36 @@ def test_bad_input_is_a_config_error():
     one = BarHingeModel.from_pattern(patterns.miura(1, 1, a=1.0, b=1.5, alpha=60.0, fold=50.0))
     with pytest.raises(ConfigError, match="2 x 2 periods"):
         periodic_cell(one, T)
+
+
+def test_docs_example_runs_and_the_doc_table_matches_the_script():
+    """docs/periodic.md: its example runs and gives the Schenk & Guest ratio's neighbourhood
+    at the default material (folds soft against the panels: within 1e-3); its tables are
+    the output of scripts/periodic_table.py (up to the date stamp)."""
+    import importlib.util
+    import re
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    text = (root / "docs" / "periodic.md").read_text(encoding="utf-8")
+    block = re.search(r"```python\n(.*?)```", text, flags=re.S)
+    ns: dict = {"__name__": "periodic_doc", "print": lambda *a, **k: None}
+    exec(compile(block.group(1), "docs/periodic.md", "exec"), ns)
+    assert ns["cell"].moduli()["nu21"] == pytest.approx(ns["g"].nu_SL, rel=1e-3)
+    spec = importlib.util.spec_from_file_location(
+        "periodic_table", root / "scripts" / "periodic_table.py"
+    )
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    ex, slopes, moduli = mod.sheet_rows()
+    table = mod.render(mod.limit_rows(), ex, slopes, moduli)
+    body = text[text.index(mod.START) + len(mod.START) : text.index(mod.END)]
+
+    def numbers(s: str) -> np.ndarray:
+        lines = [ln for ln in s.strip().splitlines() if not ln.startswith("*Generated")]
+        return np.array(
+            [float(x) for x in re.findall(r"-?\d+\.?\d*(?:e[-+]\d+)?", "\n".join(lines))]
+        )
+
+    # the values to their printed digits; errors at round-off (~1e-9) may differ by machine
+    np.testing.assert_allclose(numbers(body), numbers(table), rtol=2e-3, atol=1e-8)
