@@ -75,3 +75,32 @@ def test_patterns_without_two_states_are_rejected():
         patterns.kresling(6, 1, height=0.8, shift=0.3, fold=2)
     with pytest.raises(PatternError, match="expected None"):
         patterns.kresling(6, 1, height=1.6, shift=0.3, fold=3)
+
+
+def test_bistable_scene_reaches_the_second_state_over_a_barrier():
+    """data/scenes/kresling_bistable.toml: its prescribed drop is H2 - H1 of the closed form;
+    solved, the bars' energy rises to a barrier and returns to (almost) zero in the short
+    state, where the top has turned by phi_2 (free, found by the solver)."""
+    from pathlib import Path
+
+    import barhinge as bh
+
+    path_toml = Path(__file__).resolve().parents[2] / "data" / "scenes" / "kresling_bistable.toml"
+    scene = bh.load_scene(path_toml)
+    st = kresling_states(6, 1.0, 1.6, 0.3)
+    top = np.flatnonzero(np.isfinite(scene.prescribed[:, 2]))
+    assert len(top) == 6
+    np.testing.assert_allclose(scene.prescribed[top, 2], st.H[1] - st.H[0], rtol=1e-15)
+    path = bh.solve(scene)
+    m = scene.model
+    bars = np.array([m.element_energies(X)[0].sum() for X in path.X])
+    k = int(np.argmax(bars))
+    assert 0 < k < len(bars) - 1 and bars[k] > 1e3 * bars[-1]
+    # the folds (rest angles of the tall state) load the bars a little: O(k_fold / EA),
+    # measured 6e-10 of the barrier
+    assert bars[-1] < 1e-8 * bars[k]
+    X = path.X[-1, top]
+    turn = np.arctan2(X[:, 1], X[:, 0]) - 2 * np.pi * np.arange(6) / 6
+    np.testing.assert_allclose(
+        np.remainder(turn + np.pi, 2 * np.pi) - np.pi, st.phi[1], atol=1e-5
+    )  # fold moments: measured 2.3e-6
