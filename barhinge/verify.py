@@ -17,6 +17,7 @@ Adding a case: write a function returning ``{quantity: computed}`` and register 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 import math
 import time
@@ -1027,8 +1028,8 @@ _KN, _KH, _KS = 6, 1.6, 0.3
 
 
 def _kresling_truss_energy(H: float, x0: Sequence[float]) -> tuple[float, np.ndarray]:
-    """Truss model of one Kresling story written out (Cai et al. 2015; Yasuda et al. 2017),
-    reduced by its n-fold symmetry: bottom polygon fixed (circumradius R), top polygon of
+    """Truss model of one Kresling story written out (Cai et al. 2015; Yasuda, Tachi, Lee &
+    Yang 2017, Nat. Commun. 8:962), reduced by its n-fold symmetry: bottom polygon fixed (circumradius R), top polygon of
     radius r turned by phi at height H; n top sides, n slanted bars and n diagonals with the
     Green-strain bar energy EA L0 eps^2 / 2 (EA = 1). Minimised over (r, phi) by BFGS;
     returns (energy, (r, phi))."""
@@ -1101,14 +1102,10 @@ def _kresling_reference() -> dict[str, float]:
     return {"barrier": -float(top.fun), "limit_force": -float(peak.fun)}
 
 
-_KREF = None
-
-
+@functools.cache
 def _kresling_ref() -> dict[str, float]:
-    global _KREF
-    if _KREF is None:
-        _KREF = _kresling_reference()
-    return _KREF
+    """:func:`_kresling_reference`, computed once per process."""
+    return _kresling_reference()
 
 
 def _kresling() -> dict[str, float]:
@@ -1171,8 +1168,9 @@ _KCF = _kresling_closed_form()
 _kresling_case = Case(
     name="kresling_bistability",
     citation=(
-        "Cai, Deng, Zhou, Feng & Zhou 2015, J. Mech. Des. 137(6):061406 (truss model, stable "
-        "states); Yasuda, Tachi & Yang 2017, PRE 96:033002 (Kresling energy landscape)"
+        "Cai, Deng, Zhou, Feng & Tu 2015, J. Mech. Des. 137(6):061406 (truss model, stable "
+        "states); Yasuda, Tachi, Lee & Yang 2017, Nat. Commun. 8:962 (truss model of "
+        "triangulated cylindrical origami)"
     ),
     description=(
         "One-story hexagonal Kresling tower (a=1, flat height 1.6, shift 0.3) as bars with "

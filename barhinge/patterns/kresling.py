@@ -17,7 +17,7 @@ Folded tower (``fold=1`` or ``fold=2``): the seam is closed, the polygons are re
 ``n``-gons of circumradius ``R = a / (2 sin(pi / n))`` and each story's top polygon is turned
 by ``phi`` and raised by ``H`` over its bottom one. The two states in which every crease has
 its flat-pattern length (stress-free for a bar model: the two stable states of the truss model
-of Kresling bistability; Cai, Deng, Zhou, Feng & Zhou, "Bistable behavior of the cylindrical
+of Kresling bistability; Cai, Deng, Zhou, Feng & Tu, "Bistable behavior of the cylindrical
 origami structure with Kresling pattern", J. Mech. Des. 137(6):061406, 2015) follow from
 ``b^2 = 2 R^2 (1 - cos phi) + H^2`` (slanted crease) and
 ``c^2 = 2 R^2 (1 - cos(phi + 2 pi / n)) + H^2`` (diagonal):

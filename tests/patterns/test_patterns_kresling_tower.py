@@ -1,5 +1,5 @@
 """Folded Kresling towers (patterns.kresling(fold=1 | 2)) against the closed-form stable
-states of the truss model (Cai, Deng, Zhou, Feng & Zhou 2015, J. Mech. Des. 137(6):061406)."""
+states of the truss model (Cai, Deng, Zhou, Feng & Tu 2015, J. Mech. Des. 137(6):061406)."""
 
 from __future__ import annotations
 
