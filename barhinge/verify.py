@@ -1030,9 +1030,9 @@ _KN, _KH, _KS = 6, 1.6, 0.3
 def _kresling_truss_energy(H: float, x0: Sequence[float]) -> tuple[float, np.ndarray]:
     """Truss model of one Kresling story written out (Cai et al. 2015; Yasuda, Tachi, Lee &
     Yang 2017, Nat. Commun. 8:962), reduced by its n-fold symmetry: bottom polygon fixed
-    (circumradius R), top polygon of radius r turned by phi at height H; n top sides, n slanted bars and n diagonals with the
-    Green-strain bar energy EA L0 eps^2 / 2 (EA = 1). Minimised over (r, phi) by BFGS;
-    returns (energy, (r, phi))."""
+    (circumradius R), top polygon of radius r turned by phi at height H; n top sides, n
+    slanted bars and n diagonals with the Green-strain bar energy EA L0 eps^2 / 2 (EA = 1).
+    Minimised over (r, phi) by BFGS; returns (energy, (r, phi))."""
     from scipy.optimize import minimize
 
     n, a = _KN, 1.0
