@@ -270,8 +270,9 @@ def periodic_cell(
     Raises
     ------
     ConfigError
-        Bad lattice, nodes that are not lattice translates, a sheet too small to hold every
-        element class (checked on the node count), or a singular cell (a periodic mechanism).
+        Bad lattice, nodes that are not lattice translates, a sheet of fewer than 2 x 2
+        periods, a central copy softer than another copy of its class, or a singular cell
+        (a mechanism of the periodic fluctuation).
     """
     X = model.X0 if X is None else np.asarray(X, float)
     if X.shape != (model.n_nodes, 3):

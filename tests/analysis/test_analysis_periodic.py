@@ -62,6 +62,19 @@ def test_miura_bending_ratio_is_opposite_to_in_plane_in_the_isometric_limit(sche
     assert np.log10(err[0] / err[1]) == pytest.approx(2.0, abs=0.2)
 
 
+def test_free_folds_make_the_rigid_folding_mode_a_zero_energy_macroscopic_strain():
+    """Folds without stiffness: the Miura's rigid-folding mechanism is a macroscopic strain
+    of zero energy (ABD singular to round-off, 1e-14 of its norm) whose strain ratio is the
+    kinematic one, -cos^2(theta) tan^2(gamma) (Schenk & Guest 2013, Eq. 2) to round-off."""
+    g, model, T = _cell(1.0, 1.5, 60.0, 50.0, fold_k=0.0)
+    cell = periodic_cell(model, T)
+    w, v = np.linalg.eigh(cell.ABD)
+    assert w[0] < 1e-14 * w[-1] and w[1] > 1e-6 * w[-1]
+    mode = v[:, 0]
+    assert abs(mode[0] / mode[1]) == pytest.approx(-g.nu_SL, rel=1e-9)  # eps_L / eps_S
+    assert np.abs(mode[2:]).max() < 1e-9  # no shear, no curvature
+
+
 def test_result_does_not_depend_on_the_sheet_cut_and_glide_symmetry_removes_coupling():
     """Sheets of 2x2, 3x2 and 3x3 periods describe the same tessellation: the same ABD to
     round-off. The Miura-ori maps onto itself by z -> H - z with a shift of L (glide
