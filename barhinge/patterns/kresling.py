@@ -185,6 +185,7 @@ def kresling(
     if fold is not None:
         if fold not in (1, 2) or isinstance(fold, bool):
             raise PatternError(f"{fam}: fold = {fold!r}; expected None (flat), 1 or 2")
+        fold = int(fold)
         X, faces = _tower(n, stories, a, height, shift, fold)
         probe = build_pattern(
             X, faces, assignment=np.full(3 * n * stories + n, "F"), family=fam,

@@ -75,6 +75,7 @@ def test_patterns_without_two_states_are_rejected():
         patterns.kresling(6, 1, height=0.8, shift=0.3, fold=2)
     with pytest.raises(PatternError, match="expected None"):
         patterns.kresling(6, 1, height=1.6, shift=0.3, fold=3)
+    assert patterns.kresling(6, 1, height=1.6, shift=0.3, fold=2.0).n_vertices == 12  # TOML float
 
 
 def test_bistable_scene_reaches_the_second_state_over_a_barrier():
