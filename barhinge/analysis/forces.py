@@ -170,8 +170,10 @@ def panel_membrane_resultants(model: Any, X: np.ndarray) -> tuple[np.ndarray, np
         )
     E = np.linalg.solve(AtA, Atb[:, :, None])[:, :, 0]  # Exx, Eyy, Exy (tensor shear)
     mat = model.material
-    C = mat.E / (1.0 - mat.nu**2) * np.array(
-        [[1.0, mat.nu, 0.0], [mat.nu, 1.0, 0.0], [0.0, 0.0, 1.0 - mat.nu]]
+    C = (
+        mat.E
+        / (1.0 - mat.nu**2)
+        * np.array([[1.0, mat.nu, 0.0], [mat.nu, 1.0, 0.0], [0.0, 0.0, 1.0 - mat.nu]])
     )
     N = mat.t * (E @ C.T)  # third row of C times Exy gives (1 - nu) Exy = gamma (1-nu)/2
     Ng = (

@@ -44,7 +44,11 @@ def test_bar_forces_and_reactions_of_a_triangle_truss_match_statics():
     U, _ = linear_response(m, F, S)
     res = state_results(m, m.X0 + U, S, F)
     a = np.arctan2(h, 1.0)
-    expect = {(0, 1): P / (2 * np.tan(a)), (1, 2): -P / (2 * np.sin(a)), (0, 2): -P / (2 * np.sin(a))}
+    expect = {
+        (0, 1): P / (2 * np.tan(a)),
+        (1, 2): -P / (2 * np.sin(a)),
+        (0, 2): -P / (2 * np.sin(a)),
+    }
     for b, (i, j) in enumerate(np.sort(m.bars, axis=1)):
         assert res.bar_force[b] == pytest.approx(expect[(int(i), int(j))], rel=1e-6)
     assert res.reactions[0, 1] == pytest.approx(P / 2, rel=1e-6)
@@ -154,7 +158,10 @@ def test_panel_resultants_of_a_homogeneous_deformation_are_exact(scheme):
         np.testing.assert_allclose(N[f], want, rtol=0, atol=1e-9 * np.abs(want).max())
         Pm = np.stack([e1, e2])
         np.testing.assert_allclose(
-            Pm @ Ng[f] @ Pm.T, [[want[0], want[2]], [want[2], want[1]]], rtol=0, atol=1e-9 * np.abs(want).max()
+            Pm @ Ng[f] @ Pm.T,
+            [[want[0], want[2]], [want[2], want[1]]],
+            rtol=0,
+            atol=1e-9 * np.abs(want).max(),
         )
 
 
@@ -163,10 +170,17 @@ def test_support_groups_are_the_connected_support_lines():
     xs, ys = np.meshgrid(np.arange(4.0), np.arange(3.0))
     V = np.column_stack([xs.ravel(), ys.ravel()])
     vid = lambda i, j: 4 * j + i  # noqa: E731
-    faces = [[vid(i, j), vid(i + 1, j), vid(i + 1, j + 1), vid(i, j + 1)] for j in range(2) for i in range(3)]
+    faces = [
+        [vid(i, j), vid(i + 1, j), vid(i + 1, j + 1), vid(i, j + 1)]
+        for j in range(2)
+        for i in range(3)
+    ]
     edges = sorted({tuple(sorted((f[k], f[(k + 1) % 4]))) for f in faces for k in range(4)})
     cp = CreasePattern(V, edges, ["F"] * len(edges), faces=faces).replaced(
-        assignment=["B" if (V[a, 0] == V[b, 0] in (0, 3)) or (V[a, 1] == V[b, 1] in (0, 2)) else "F" for a, b in edges]
+        assignment=[
+            "B" if (V[a, 0] == V[b, 0] in (0, 3)) or (V[a, 1] == V[b, 1] in (0, 2)) else "F"
+            for a, b in edges
+        ]
     )
     m = bh.BarHingeModel.from_pattern(cp, "N4B5")
     S = np.zeros((m.n_nodes, 3), bool)
