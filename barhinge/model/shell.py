@@ -114,7 +114,13 @@ class ShellModel:
         free = np.setdiff1d(np.arange(self.n_dof), fixed)
         Kff = sp.csc_matrix(self.K[free][:, free])
         try:
-            uf = spla.splu(Kff).solve(np.asarray(f, float)[free])
+            lu = spla.splu(
+                Kff,
+                permc_spec="MMD_AT_PLUS_A",
+                diag_pivot_thresh=0.0,
+                options={"SymmetricMode": True},
+            )
+            uf = lu.solve(np.asarray(f, float)[free])
         except RuntimeError as exc:
             raise ConfigError("shell model: the supports leave a mechanism") from exc
         if not np.all(np.isfinite(uf)):
