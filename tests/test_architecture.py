@@ -40,7 +40,7 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("kinematics", ["barhinge.kinematics", "barhinge.kinematics.*"]),
     ("kernels", ["barhinge.kernels", "barhinge.kernels.*", "barhinge.assembly"]),
     ("model", ["barhinge.model", "barhinge.model.*"]),
-    ("scene", ["barhinge.solver_options", "barhinge.scene"]),
+    ("scene", ["barhinge.solver_options", "barhinge.loads", "barhinge.scene"]),
     ("solve", ["barhinge.solve", "barhinge.solve.*"]),
     ("analysis", ["barhinge.analysis", "barhinge.analysis.*"]),
     # solve/outputs.py writes the result folder of a solved scene: an output module that lives
