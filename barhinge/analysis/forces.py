@@ -29,6 +29,7 @@ Units are the user's: forces in the load's unit, lengths in the pattern's.
 from __future__ import annotations
 
 import dataclasses
+import weakref
 from typing import Any
 
 import numpy as np
@@ -116,13 +117,25 @@ def bar_axial_forces(model: Any, X: np.ndarray) -> np.ndarray:
     return model.bar_EA * model.bar_L0 * eps * np.linalg.norm(d, axis=1)
 
 
+_FACE_BARS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
 def _face_bars(model: Any) -> tuple[np.ndarray, np.ndarray]:
-    """(bar, face) rows of the bars each face's triangulation uses."""
+    """(bar, face) rows of the bars each face's triangulation uses (cached per model)."""
+    try:
+        return _FACE_BARS[model]
+    except (KeyError, TypeError):
+        pass
     topo = build_topology(model.pattern, triangulate(model.pattern, model.scheme))
     if not np.array_equal(topo.bars, model.bars):
         raise ConfigError("the model's bars do not match its pattern's triangulation")
     bf = topo.bar_face_pairs
-    return bf[:, 0].copy(), bf[:, 1].copy()
+    out = (bf[:, 0].copy(), bf[:, 1].copy())
+    try:
+        _FACE_BARS[model] = out
+    except TypeError:  # not weak-referenceable: no cache
+        pass
+    return out
 
 
 def panel_membrane_resultants(model: Any, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

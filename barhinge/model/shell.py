@@ -75,7 +75,7 @@ class ShellModel:
     node_edge: np.ndarray
     edges: np.ndarray
     dof_edge: np.ndarray
-    _T: list = dataclasses.field(repr=False)  # per facet: (T csr, local load operators)
+    _T: list = dataclasses.field(repr=False)  # per facet: local dofs = T @ global dofs
     _frames: np.ndarray = dataclasses.field(repr=False)  # (n_faces, 3, 3) rows e1, e2, N
     _areas: list = dataclasses.field(repr=False)  # per facet: (mem (2nv,), morley (n,)) unit loads
 
@@ -91,7 +91,7 @@ class ShellModel:
         if per not in ("area", "plan"):
             raise ConfigError(f"per = {per!r}; expected 'area' or 'plan'")
         f = np.zeros(self.n_dof)
-        for fi, (T, _) in enumerate(self._T):
+        for fi, T in enumerate(self._T):
             R = self._frames[fi]
             s = abs(R[2, 2]) if per == "plan" else 1.0
             ql = R @ q * s
@@ -337,7 +337,7 @@ def shell_model(
 
     # 4. assemble K = sum T^T K_f T
     rows_all, cols_all, vals_all = [], [], []
-    Ts, areas, frames, tris = [], [], [], []
+    Ts, frames, tris = [], [], []
     for fi, (_, R, loc, _) in enumerate(facets):
         g = node_of[fi]
         nloc = len(g)
@@ -364,8 +364,7 @@ def shell_model(
         rows_all.append(Kg.row)
         cols_all.append(Kg.col)
         vals_all.append(Kg.data)
-        Ts.append((T, None))
-        areas.append((loc["lm"], loc["lp"]))
+        Ts.append(T)
         frames.append(R)
         tris.append(g[loc["mesh"].t.T])
     for a, b, kl in springs:
@@ -376,7 +375,7 @@ def shell_model(
         (np.concatenate(vals_all), (np.concatenate(rows_all), np.concatenate(cols_all))),
         shape=(ndof, ndof),
     )
-    # membrane unit loads: lm holds (x + y) per node pair; split back to per-dof unit weights
+    # unit loads per facet: membrane (x, y interleaved) and plate
     areas = [(_per_dof(loc), loc["lp"]) for _, _, loc, _ in facets]
     return ShellModel(
         points=points,
