@@ -23,8 +23,9 @@ its own ``omega`` and a rotational spring ``k l (omega_A - omega_B)^2 / 2`` per 
 length ``l`` joins them (the same crease law as the bar-and-hinge fold hinges).
 
 Convergence: displacements converge as ``O(h^2)`` (CST membrane and Morley plate alike). The
-square plate under uniform load is the textbook check (tests/model/test_model_shell.py:
-Timoshenko & Woinowsky-Krieger 1959, Tables 8 and 35).
+checks (tests/model/test_model_shell.py): the square plate under uniform load, simply
+supported and clamped (Timoshenko & Woinowsky-Krieger 1959, Tables 8 and 35), and the
+Scordelis-Lo roof (MacNeal & Harder 1985), faceted.
 """
 
 from __future__ import annotations
