@@ -39,3 +39,11 @@ def test_bar_hinge_error_shrinks_under_subdivision(study) -> None:
         assert e[1] < e[0]
         assert not math.isnan(r["rate"][v]) and r["rate"][v] > 0
     assert "| pleats | 90 |" in study.table(study.RESULTS)
+
+
+def test_flat_plate_shell_approaches_navier(study) -> None:
+    """The shell's compliance stiffness of the simply supported square plate approaches the
+    Navier series value (an independent closed form) from below (Morley is soft)."""
+    r = [s["ratio"] for s in study.PLATE["shell"]]
+    assert r[0] < r[1] < 1.0
+    assert r[-1] > 0.9
