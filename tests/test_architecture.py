@@ -40,12 +40,21 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("kinematics", ["barhinge.kinematics", "barhinge.kinematics.*"]),
     ("kernels", ["barhinge.kernels", "barhinge.kernels.*", "barhinge.assembly"]),
     ("model", ["barhinge.model", "barhinge.model.*"]),
-    ("scene", ["barhinge.solver_options", "barhinge.scene"]),
+    ("scene", ["barhinge.solver_options", "barhinge.loads", "barhinge.scene"]),
     ("solve", ["barhinge.solve", "barhinge.solve.*"]),
     ("analysis", ["barhinge.analysis", "barhinge.analysis.*"]),
     # solve/outputs.py writes the result folder of a solved scene: an output module that lives
     # in solve/ by name only (nothing in the solver imports it)
-    ("output", ["barhinge.solve.outputs", "barhinge.io", "barhinge.plot", "barhinge.plot.*"]),
+    (
+        "output",
+        [
+            "barhinge.solve.outputs",
+            "barhinge.io",
+            "barhinge.modes_vtu",
+            "barhinge.plot",
+            "barhinge.plot.*",
+        ],
+    ),
     ("apps", ["barhinge.verify", "barhinge.sweep"]),
     ("cli", ["barhinge.cli", "barhinge.__main__"]),
     ("api", ["barhinge"]),
