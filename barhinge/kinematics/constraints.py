@@ -185,7 +185,7 @@ class RigidConstraints:
         X = pat.vertices3d
         verts: list[int] = []
         loops: list[list[int]] = []
-        corner_pts: list[tuple[int, int, int]] = []  # (vertex, next, prev) of each sector
+        corner_pts: list[tuple[int, int, int, int]] = []  # (vertex, next, prev, face) per sector
         interior = np.zeros(pat.n_vertices, bool)
         interior[pat.interior_vertices] = True
         ok_edge = ((var_of_edge >= 0) & (EF >= 0).all(1)).tolist()
@@ -207,7 +207,7 @@ class RigidConstraints:
                     ok = False
                     break
                 lv.append(var_list[e])
-                cp_.append((v, nxt, prv))
+                cp_.append((v, nxt, prv, fi))
             if ok:
                 verts.append(v)
                 loops.append(lv)
@@ -216,10 +216,12 @@ class RigidConstraints:
         loop_var = -np.ones((len(loops), D), dtype=np.int64)
         for i, lv in enumerate(loops):
             loop_var[i, : len(lv)] = lv
-        # sector angles of all corners at once (current geometry = reference state)
-        C = np.asarray(corner_pts, dtype=np.int64).reshape(-1, 3)
+        # sector angles of all corners at once (current geometry = reference state), measured
+        # counter-clockwise about the face normal: a reflex corner of a non-convex panel is > pi
+        C = np.asarray(corner_pts, dtype=np.int64).reshape(-1, 4)
         u, w = X[C[:, 1]] - X[C[:, 0]], X[C[:, 2]] - X[C[:, 0]]
-        ang = np.arctan2(np.linalg.norm(np.cross(u, w), axis=1), np.einsum("ij,ij->i", u, w))
+        s = np.einsum("ij,ij->i", np.cross(u, w), pat.face_normals[C[:, 3]])
+        ang = np.mod(np.arctan2(s, np.einsum("ij,ij->i", u, w)), 2 * np.pi)
         loop_alpha = np.zeros((len(loops), D))
         loop_alpha[loop_var >= 0] = ang
         rho0 = (

@@ -363,34 +363,73 @@ def local_dof(
     s = np.linalg.svd(B, compute_uv=False)  # (nv, min(3, D))
     rank_v = (s > rel * np.maximum(s.max(1, keepdims=True), 1e-300)).sum(1)
     local[rc.vertices] = deg - rank_v
-    # regions: vertex + neighbours sharing a crease
-    owner = -np.ones(rc.n_var * 2, dtype=np.int64).reshape(rc.n_var, 2)
-    cnt = np.zeros(rc.n_var, dtype=np.int64)
-    for i, lv in enumerate(rc.loop_var):
-        for k in lv[lv >= 0]:
-            owner[k, cnt[k]] = i
-            cnt[k] += 1
-    members = []
-    for i, lv in enumerate(rc.loop_var):
-        nb = owner[lv[lv >= 0]].ravel()
-        members.append(np.unique(np.concatenate([[i], nb[nb >= 0]])))
-    rmax = max(len(m) for m in members)
-    D = rc.loop_var.shape[1]
-    cmax = rmax * D
-    M = np.zeros((nv, 3 * rmax, cmax))
-    nvar = np.zeros(nv, dtype=np.int64)
-    for i, mem in enumerate(members):
-        vars_ = np.unique(rc.loop_var[mem][rc.loop_var[mem] >= 0])
-        pos = {int(k): c for c, k in enumerate(vars_)}
-        nvar[i] = len(vars_)
-        for r, w in enumerate(mem):
-            lv = rc.loop_var[w]
-            for d in np.flatnonzero(lv >= 0):
-                M[i, 3 * r : 3 * r + 3, pos[int(lv[d])]] = B[w, :, d]
-    s = np.linalg.svd(M, compute_uv=False)
-    rank_r = (s > rel * np.maximum(s.max(1, keepdims=True), 1e-300)).sum(1)
-    region[rc.vertices] = nvar - rank_r
+    region[rc.vertices] = _region_dof(rc.loop_var, B, rel)
     return local, region
+
+
+def _region_members(loop_var: np.ndarray) -> np.ndarray:
+    """(n_cv, R) int: each constrained vertex followed by the constrained vertices that share
+    a crease with it (-1 padding); a crease variable lies in at most two vertex loops."""
+    nv, D = loop_var.shape
+    ok = loop_var >= 0
+    owner = np.broadcast_to(np.arange(nv)[:, None], (nv, D))[ok]
+    var = loop_var[ok]
+    order = np.argsort(var, kind="stable")
+    var, owner = var[order], owner[order]
+    same = np.flatnonzero(var[1:] == var[:-1])  # the two loops of a shared crease
+    a, b = owner[same], owner[same + 1]
+    src = np.concatenate([a, b])
+    dst = np.concatenate([b, a])
+    pairs = np.unique(np.column_stack([src, dst]), axis=0)  # sorted by src
+    cnt = np.bincount(pairs[:, 0], minlength=nv)
+    R = 1 + int(cnt.max(initial=0))
+    members = -np.ones((nv, R), dtype=np.int64)
+    members[:, 0] = np.arange(nv)
+    start = np.concatenate([[0], np.cumsum(cnt)[:-1]])
+    slot = 1 + np.arange(len(pairs)) - start[pairs[:, 0]]
+    members[pairs[:, 0], slot] = pairs[:, 1]
+    return members
+
+
+def _region_dof(
+    loop_var: np.ndarray, B: np.ndarray, rel: float, chunk_bytes: float = 64e6
+) -> np.ndarray:
+    """(n_cv,) DOF of each one-ring region: ``(creases of the region) - rank`` of its stacked
+    vertex blocks ``B`` (n_cv, 3, D), all regions at once (batched SVD, in chunks that keep
+    the stacked matrices below ``chunk_bytes``)."""
+    nv, D = loop_var.shape
+    members = _region_members(loop_var)
+    R = members.shape[1]
+    # variables of every (region, member, slot); -1 where the member or slot is padding
+    V = np.where(members[:, :, None] >= 0, loop_var[np.maximum(members, 0)], -1)  # (nv, R, D)
+    flat = V.reshape(nv, R * D)
+    big = np.iinfo(np.int64).max
+    key = np.where(flat >= 0, flat, big)
+    order = np.argsort(key, axis=1, kind="stable")
+    srt = np.take_along_axis(key, order, axis=1)
+    new = np.ones_like(srt, dtype=bool)
+    new[:, 1:] = srt[:, 1:] != srt[:, :-1]
+    pos_sorted = np.cumsum(new, axis=1) - 1
+    pos = np.empty_like(pos_sorted)
+    np.put_along_axis(pos, order, pos_sorted, axis=1)  # column of each entry in its region
+    nvar = np.sum(new & (srt != big), axis=1)
+    C = int(nvar.max(initial=0))
+    out = np.zeros(nv, dtype=np.int64)
+    per = max(1, int(chunk_bytes // (8 * 3 * R * max(C, 1))))
+    rows3 = np.arange(3)
+    for lo in range(0, nv, per):  # a few chunks, not a loop over vertices
+        hi = min(nv, lo + per)
+        n = hi - lo
+        M = np.zeros((n, R, 3, C))
+        Vc = V[lo:hi]
+        i, r, d = np.nonzero(Vc >= 0)
+        p = pos[lo:hi].reshape(n, R, D)[i, r, d]
+        w = members[lo:hi][i, r]
+        M[i[:, None], r[:, None], rows3[None, :], p[:, None]] = B[w, :, d]
+        s = np.linalg.svd(M.reshape(n, 3 * R, C), compute_uv=False)
+        smax = np.maximum(s.max(1, initial=0.0), 1e-300)
+        out[lo:hi] = nvar[lo:hi] - (s > rel * smax[:, None]).sum(1)
+    return out
 
 
 # ------------------------------------------------------------------------- actuators
@@ -514,43 +553,79 @@ def folded_sample(
 ) -> np.ndarray:
     """A rigidly folded state near the flat one.
 
-    The branch direction (target angles, else M/V signs) is scaled to ``magnitude`` rad; the
+    The branch direction (target angles, else M/V signs; unassigned ``U`` and ``F`` creases
+    have no sign and start at 0, free to fold either way) is scaled to ``magnitude`` rad; the
     crease with the largest component is held there and the others are projected onto the
     constraints by minimum-norm Gauss-Newton (holding one crease keeps the projection from
-    collapsing onto the flat apex of the configuration cone). Raises PatternError if no
-    folded state is found (e.g. a pattern that is not rigidly foldable).
+    collapsing onto the flat apex of the configuration cone). When full steps from that guess
+    do not close, the hold is raised in steps (magnitude / 8, / 4, / 2, 1, each predicted
+    from the last) and a step is halved until the closure error ``sum |F - I|²`` falls: the
+    residual ``vee(skew F)`` also vanishes at loops turned by 180°, which an unguarded step
+    can land on. Raises PatternError if no folded state is found (e.g. a pattern that is not
+    rigidly foldable).
     """
     d = _branch_direction(rc)
     if not np.any(d):
         raise PatternError("no folded state: the pattern has no assignment or target angles")
-    rho0 = magnitude * d / np.max(np.abs(d))
+    d = d / np.max(np.abs(d))
     hold = int(np.argmax(np.abs(d)))
     free = np.ones(rc.n_var, bool)
     free[hold] = False
-    err = np.inf
     backend = None
     if rc.n_var > DENSE_LIMIT:
         from barhinge.linalg.backends import get_backend
 
         backend = get_backend("auto")
-    for fix in (True, False):
-        rho = rho0.copy()
-        cols = np.flatnonzero(free) if fix else np.arange(rc.n_var)
+
+    def merit(x: np.ndarray) -> float:
+        return float(np.sum(rc.closure_error(x) ** 2)) if len(rc.vertices) else 0.0
+
+    def project(rho: np.ndarray, cols: np.ndarray, guarded: bool) -> np.ndarray:
+        m = merit(rho)
         for _ in range(max_iter):
             r, J = rc.evaluate(rho)
-            if np.max(np.abs(r), initial=0.0) < 1e-13:
+            if np.max(np.abs(r), initial=0.0) < 1e-13 and m < 1e-20:
                 break
-            rho[cols] += _min_norm_step(J[:, cols], -r, backend)
-        err = float(rc.closure_error(rho).max()) if len(rc.vertices) else 0.0
-        if err <= 1e-9 and np.max(np.abs(rho)) >= 1e-3 * magnitude:
-            return rho
-    if err > 1e-9:
+            step = np.zeros(rc.n_var)
+            step[cols] = _min_norm_step(J[:, cols], -r, backend)
+            lam = 1.0
+            if guarded and m > 1e-8:  # near a solution full steps converge quadratically
+                while lam > 1e-4 and merit(rho + lam * step) >= m:
+                    lam *= 0.5
+                if lam <= 1e-4:
+                    break  # no descent: a local minimum of the closure error
+            rho = rho + lam * step
+            m = merit(rho)
+        return rho
+
+    best = (np.inf, None)
+    collapsed = False
+    for guarded in (False, True):
+        for fix in (True, False):
+            cols = np.flatnonzero(free) if fix else np.arange(rc.n_var)
+            ts = magnitude * (np.array([0.125, 0.25, 0.5, 1.0]) if guarded else np.ones(1))
+            rho = np.zeros(rc.n_var)
+            t_prev = 0.0
+            for t in ts:
+                # predictor: the last state scaled (a cone through the flat state), else d
+                rho = rho * (t / t_prev) if t_prev > 0 else t * d
+                rho[hold] = t * d[hold]
+                t_prev = t
+                rho = project(rho, cols, guarded)
+            err = float(rc.closure_error(rho).max()) if len(rc.vertices) else 0.0
+            if err <= 1e-9:
+                if np.max(np.abs(rho)) >= 1e-3 * magnitude:
+                    return rho
+                collapsed = True
+            elif err < best[0]:
+                best = (err, rho)
+    if collapsed:
         raise PatternError(
-            f"no rigidly folded state found near the flat one (closure error {err:.1e})"
+            "the projection of the M/V direction onto the constraints collapses to the flat "
+            "state: the pattern is not rigidly foldable (with rigid panels)"
         )
     raise PatternError(
-        "the projection of the M/V direction onto the constraints collapses to the flat "
-        "state: the pattern is not rigidly foldable (with rigid panels)"
+        f"no rigidly folded state found near the flat one (closure error {best[0]:.1e})"
     )
 
 
