@@ -4,7 +4,8 @@
   structures", Proc. IASS): ``E_in - 3 V_in - sum_panels (n - 3)`` where ``E_in`` counts the
   interior creases of the triangulated pattern and ``V_in`` the interior vertices; each n-gon
   panel adds ``n - 3`` diagonals and ``n - 3`` planarity conditions, so the count equals
-  (creases) - 3 (interior vertices) in the angle formulation.
+  (creases) - 3 (interior vertices) in the angle formulation; each hole subtracts 6 more
+  (the closure of the chain of panels around it, :mod:`barhinge.kinematics.holes`).
 * True (first-order) DOF: ``n_var - rank J`` with ``J`` the loop-closure Jacobian
   (:mod:`barhinge.kinematics.constraints`) at the given state; the number of redundant
   constraints is ``rank deficiency of the rows = DOF - count``. The flat state is special:
@@ -33,10 +34,11 @@ import scipy.sparse as sp
 
 from barhinge.errors import ConfigError, PatternError
 from barhinge.kinematics.constraints import RigidConstraints
+from barhinge.kinematics.holes import hole_loops
 from barhinge.linalg.nullspace import DENSE_LIMIT, NullSpace, RankError, null_space
 from barhinge.pattern.crease import CreasePattern
 
-__all__ = ["DofReport", "dof", "select_actuators", "folded_sample"]
+__all__ = ["DofReport", "dof", "select_actuators", "folded_sample", "system", "closure_errors"]
 
 log = logging.getLogger(__name__)
 
@@ -53,7 +55,7 @@ class DofReport:
     global_dof : int
         First-order DOF ``n_variables - rank`` at this state.
     counted_dof : int
-        Tachi (2010) count ``E_in - 3 V_in - sum(n - 3)``.
+        Tachi (2010) count ``E_in - 3 V_in - 6 holes - sum(n - 3)``.
     redundant : int
         Redundant constraints ``global_dof - counted_dof`` (= n_equations - rank).
     rank : int
@@ -205,12 +207,23 @@ def dof(
     rc = RigidConstraints.from_pattern(cp, triangulated=triangulated)
     rho = _state_angles(rc, state)
     rep = _report(rc, rho, prefer=prefer, tol=tol)
-    if rc.holes:
+    hl = hole_loops(rc)
+    if hl.n_holes:
         rep = dataclasses.replace(
             rep,
             note=_join(
                 rep.note,
-                f"the pattern has {rc.holes} hole(s): loops of panels around a hole are not "
+                f"the pattern has {hl.n_holes} hole(s): the chain of panels around each adds "
+                "6 closure conditions",
+            ),
+        )
+    missing = rc.holes - hl.n_holes
+    if missing > 0:
+        rep = dataclasses.replace(
+            rep,
+            note=_join(
+                rep.note,
+                f"{missing} hole(s) whose boundary touches another boundary loop are not "
                 "constrained, so the DOF may be over-estimated",
             ),
         )
@@ -218,7 +231,14 @@ def dof(
         try:
             rho_f = folded_sample(rc)
         except PatternError as exc:
-            return dataclasses.replace(rep, note=_join(rep.note, str(exc)))
+            msg = str(exc)
+            n_poly = sum(len(f) > 3 for f in rc.pattern.faces)
+            if n_poly and not rc.triangulated:
+                msg += (
+                    f"; {n_poly} non-triangular panel(s) are held rigid and flat "
+                    "(triangulated=True / --triangulated lets them fold along a diagonal)"
+                )
+            return dataclasses.replace(rep, note=_join(rep.note, msg))
         folded = _report(rc, rho_f, prefer=prefer, tol=tol)
         wrong = _against_assignment(rc, rho_f)
         if wrong:
@@ -271,14 +291,32 @@ def _state_angles(rc: RigidConstraints, state: Any) -> np.ndarray:
     return rho
 
 
-def _report(rc: RigidConstraints, rho: np.ndarray, *, prefer: Any, tol: float | None) -> DofReport:
+def system(rc: RigidConstraints, rho: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix]:
+    """Residual and Jacobian of all the closure conditions at ``rho`` (n_var,) radians:
+    the vertex loops (3 rows each) followed by the chains around holes (6 rows each)."""
     r, J = rc.evaluate(rho)
+    hl = hole_loops(rc)
+    if hl.n_holes == 0:
+        return r, J
+    rh, Jh = hl.evaluate(rho)
+    return np.concatenate([r, rh]), sp.vstack([J, Jh], format="csr")
+
+
+def closure_errors(rc: RigidConstraints, rho: np.ndarray) -> np.ndarray:
+    """Closure error ``|F - I|`` of every vertex loop followed by that of every hole chain
+    (``|R - I| + |t| / size``)."""
+    return np.concatenate([rc.closure_error(rho), hole_loops(rc).closure_error(rho)])
+
+
+def _report(rc: RigidConstraints, rho: np.ndarray, *, prefer: Any, tol: float | None) -> DofReport:
+    r, J = system(rc, rho)
     ns = null_space(J, tol)
     n_faces_extra = 0 if rc.triangulated else sum(len(f) - 3 for f in rc.pattern.faces)
     e_in_tri = rc.n_var + n_faces_extra
-    counted = e_in_tri - 3 * len(rc.vertices) - n_faces_extra
+    n_holes = hole_loops(rc).n_holes
+    counted = e_in_tri - 3 * len(rc.vertices) - 6 * n_holes - n_faces_extra
     g = rc.n_var - ns.rank
-    closure = float(rc.closure_error(rho).max()) if len(rc.vertices) else 0.0
+    closure = float(closure_errors(rc, rho).max(initial=0.0))
     flat = bool(np.max(np.abs(rho), initial=0.0) < FLAT_TOL)
     local, region = local_dof(rc, rho, tol=tol)
     acts = select_actuators(rc, ns, prefer=prefer)
@@ -310,7 +348,7 @@ def _report(rc: RigidConstraints, rho: np.ndarray, *, prefer: Any, tol: float | 
         sigma_gap=ns.sigma_gap,
         method=ns.method,
         n_variables=rc.n_var,
-        n_equations=rc.n_eq,
+        n_equations=J.shape[0],
         n_interior_vertices=len(rc.vertices),
         flat=flat,
         local=local,
@@ -578,12 +616,12 @@ def folded_sample(
         backend = get_backend("auto")
 
     def merit(x: np.ndarray) -> float:
-        return float(np.sum(rc.closure_error(x) ** 2)) if len(rc.vertices) else 0.0
+        return float(np.sum(closure_errors(rc, x) ** 2))
 
     def project(rho: np.ndarray, cols: np.ndarray, guarded: bool) -> np.ndarray:
         m = merit(rho)
         for _ in range(max_iter):
-            r, J = rc.evaluate(rho)
+            r, J = system(rc, rho)
             if np.max(np.abs(r), initial=0.0) < 1e-13 and m < 1e-20:
                 break
             step = np.zeros(rc.n_var)
@@ -612,7 +650,7 @@ def folded_sample(
                 rho[hold] = t * d[hold]
                 t_prev = t
                 rho = project(rho, cols, guarded)
-            err = float(rc.closure_error(rho).max()) if len(rc.vertices) else 0.0
+            err = float(closure_errors(rc, rho).max(initial=0.0))
             if err <= 1e-9:
                 if np.max(np.abs(rho)) >= 1e-3 * magnitude:
                     return rho
