@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -175,6 +175,7 @@ def dof(
     prefer: str | Sequence[int] | None = None,
     tol: float | None = None,
     folded_check: bool = True,
+    progress: Callable[[str, int, int], None] | None = None,
 ) -> DofReport:
     """Global and local degrees of freedom of ``cp`` as a rigid origami.
 
@@ -194,6 +195,10 @@ def dof(
         Relative singular-value threshold for the rank (default 1e-8 dense SVD, 1e-6 sparse).
     folded_check : bool
         At a flat state, also analyse a folded state nearby (``report.folded``).
+    progress : callable, optional
+        Called as ``progress(stage, done, total)`` before each stage of the work (the rank,
+        local DOF, actuators, the folded-state search, ...) and once at the end with
+        ``done == total`` (the CLI draws a progress bar from it).
 
     Returns
     -------
@@ -204,9 +209,13 @@ def dof(
         if s.ndim == 2 and s.shape == (cp.n_vertices, 3):
             cp = cp.replaced(vertices=s, validate=False)
             state = None
+    tick = _Ticker(progress, 4)
+    tick("loop-closure constraints")
     rc = RigidConstraints.from_pattern(cp, triangulated=triangulated)
     rho = _state_angles(rc, state)
-    rep = _report(rc, rho, prefer=prefer, tol=tol)
+    if folded_check and rc.n_var > 0 and np.max(np.abs(rho), initial=0.0) < FLAT_TOL:
+        tick.total = 8
+    rep = _report(rc, rho, prefer=prefer, tol=tol, tick=tick)
     hl = hole_loops(rc)
     if hl.n_holes:
         rep = dataclasses.replace(
@@ -228,9 +237,11 @@ def dof(
             ),
         )
     if rep.flat and folded_check and rc.n_var > 0:
+        tick("folded state nearby")
         try:
             rho_f = folded_sample(rc)
         except PatternError as exc:
+            tick.finish()
             msg = str(exc)
             n_poly = sum(len(f) > 3 for f in rc.pattern.faces)
             if n_poly and not rc.triangulated:
@@ -239,7 +250,7 @@ def dof(
                     "(triangulated=True / --triangulated lets them fold along a diagonal)"
                 )
             return dataclasses.replace(rep, note=_join(rep.note, msg))
-        folded = _report(rc, rho_f, prefer=prefer, tol=tol)
+        folded = _report(rc, rho_f, prefer=prefer, tol=tol, tick=tick)
         wrong = _against_assignment(rc, rho_f)
         if wrong:
             folded = dataclasses.replace(
@@ -259,7 +270,24 @@ def dof(
                 f"at a folded state nearby the DOF is {folded.global_dof}",
             ),
         )
+    tick.finish()
     return rep
+
+
+class _Ticker:
+    """Counts the stages of :func:`dof` for a ``progress(stage, done, total)`` callback."""
+
+    def __init__(self, progress: Callable[[str, int, int], None] | None, total: int) -> None:
+        self.progress, self.total, self.done = progress, total, 0
+
+    def __call__(self, stage: str) -> None:
+        if self.progress is not None:
+            self.progress(stage, self.done, self.total)
+        self.done += 1
+
+    def finish(self) -> None:
+        if self.progress is not None:
+            self.progress("done", self.total, self.total)
 
 
 def _against_assignment(rc: RigidConstraints, rho: np.ndarray) -> int:
@@ -308,7 +336,15 @@ def closure_errors(rc: RigidConstraints, rho: np.ndarray) -> np.ndarray:
     return np.concatenate([rc.closure_error(rho), hole_loops(rc).closure_error(rho)])
 
 
-def _report(rc: RigidConstraints, rho: np.ndarray, *, prefer: Any, tol: float | None) -> DofReport:
+def _report(
+    rc: RigidConstraints,
+    rho: np.ndarray,
+    *,
+    prefer: Any,
+    tol: float | None,
+    tick: Callable[[str], None] = lambda stage: None,
+) -> DofReport:
+    tick(f"rank of the {rc.n_var}-crease Jacobian")
     r, J = system(rc, rho)
     ns = null_space(J, tol)
     n_faces_extra = 0 if rc.triangulated else sum(len(f) - 3 for f in rc.pattern.faces)
@@ -318,7 +354,9 @@ def _report(rc: RigidConstraints, rho: np.ndarray, *, prefer: Any, tol: float | 
     g = rc.n_var - ns.rank
     closure = float(closure_errors(rc, rho).max(initial=0.0))
     flat = bool(np.max(np.abs(rho), initial=0.0) < FLAT_TOL)
+    tick("local and region DOF")
     local, region = local_dof(rc, rho, tol=tol)
+    tick("actuators")
     acts = select_actuators(rc, ns, prefer=prefer)
     note = ""
     if closure > 1e-8:

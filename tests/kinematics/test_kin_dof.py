@@ -279,3 +279,16 @@ def test_unassigned_creases_fold_either_way():
     assert f.global_dof == len(cp.boundary_edges) - 3 == bh.dof(cp).folded.global_dof
     rc = RigidConstraints.from_pattern(u)
     assert f.global_dof == _nodal_dof(u, rc.coordinates(folded_sample(rc)))
+
+
+def test_progress_reports_every_stage_in_order():
+    """``bh.dof(progress=...)`` is called before each stage and once at the end (the CLI's
+    progress bar); a flat pattern with a folded state nearby has 8 stages."""
+    calls = []
+    rep = bh.dof(bh.patterns.miura(3, 3), progress=lambda *a: calls.append(a))
+    assert rep.folded is not None
+    stages = [c[0] for c in calls]
+    assert stages[0] == "loop-closure constraints" and stages[-1] == "done"
+    assert "folded state nearby" in stages and stages.count("actuators") == 2
+    done = [c[1] for c in calls]
+    assert done == sorted(done) and calls[-1][1] == calls[-1][2] == 8
