@@ -47,7 +47,7 @@ def timed(cp, repeat: int) -> tuple[float, dict[str, float], bh.DofReport]:
     for _ in range(repeat):
         marks: list[tuple[str, float]] = []
         t0 = time.perf_counter()
-        rep = bh.dof(cp, progress=lambda s, d, n: marks.append((s, time.perf_counter())))
+        rep = bh.dof(cp, progress=lambda s, d, n, m=marks: m.append((s, time.perf_counter())))
         times.append(time.perf_counter() - t0)
         acc = dict.fromkeys(STAGES, 0.0)
         for (s, t), (_, t_next) in zip(marks[:-1], marks[1:], strict=True):
@@ -110,7 +110,7 @@ def main() -> None:
             row(f, read(FILES / f), a.repeat)
     for fam, (xs, ts, ps) in fits.items():
         if len(xs) > 1:
-            slope = lambda y: np.polyfit(np.log(xs), np.log(y), 1)[0]  # noqa: E731
+            slope = lambda y, x=xs: np.polyfit(np.log(x), np.log(y), 1)[0]  # noqa: E731
             parts = ", ".join(f"{k} ^{slope(ps[k]):.2f}" for k in STAGES)
             print(f"\n{fam}: time ~ creases^{slope(ts):.2f} ({parts})")
 
