@@ -44,6 +44,9 @@ log = logging.getLogger(__name__)
 
 #: a state whose largest |fold angle| is below this (rad) is reported as flat
 FLAT_TOL = 1e-6
+#: up to this many columns a Gauss-Newton step of the folded-state search is a dense
+#: least-squares solve; above, one sparse factorisation of the damped normal matrix
+STEP_DENSE_LIMIT = DENSE_LIMIT
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -648,7 +651,7 @@ def folded_sample(
     free = np.ones(rc.n_var, bool)
     free[hold] = False
     backend = None
-    if rc.n_var > DENSE_LIMIT:
+    if rc.n_var > STEP_DENSE_LIMIT:
         from barhinge.linalg.backends import get_backend
 
         backend = get_backend("auto")
@@ -658,6 +661,7 @@ def folded_sample(
 
     def project(rho: np.ndarray, cols: np.ndarray, guarded: bool) -> np.ndarray:
         m = merit(rho)
+        slow = 0
         for _ in range(max_iter):
             r, J = system(rc, rho)
             if np.max(np.abs(r), initial=0.0) < 1e-13 and m < 1e-20:
@@ -671,7 +675,11 @@ def folded_sample(
                 if lam <= 1e-4:
                     break  # no descent: a local minimum of the closure error
             rho = rho + lam * step
-            m = merit(rho)
+            m_old, m = m, merit(rho)
+            # stalled (5 steps in a row gaining < 1 %: a local minimum or a singular point)
+            slow = slow + 1 if m > 0.99 * m_old else 0
+            if slow >= 5:
+                break
         return rho
 
     best = (np.inf, None)
@@ -711,7 +719,7 @@ def _min_norm_step(J: sp.csr_matrix, b: np.ndarray, backend: Any = None) -> np.n
     damping keeps ``x`` out of the null space of a rank-deficient ``J``; a Krylov
     least-squares solver needed 10⁴–10⁵ iterations on real patterns)."""
     m, n = J.shape
-    if n <= DENSE_LIMIT:
+    if n <= STEP_DENSE_LIMIT:
         return sla.lstsq(J.toarray(), b, cond=1e-9, lapack_driver="gelsd")[0]
     from barhinge.linalg.backends import get_backend
 
