@@ -3,7 +3,10 @@ of JᵀJ − τ²I and null space), local and region DOF (batched SVDs), the act
 (pivoted QR) and the search for a folded state nearby.
 
 Usage: python benchmarks/bench_dof.py [--sizes 10 20 35 50 70] [--repeat 3] [--no-files]
-       [--families miura yoshimura eggbox]
+       [--families miura yoshimura eggbox] [--publish]
+
+``--publish`` writes the table and the fitted exponents into docs/kinematics.md between the
+``dof-scale:start`` / ``dof-scale:end`` markers.
 
 Generated sheets (n x n unit cells of ``bh.patterns.miura``, ``yoshimura`` and ``eggbox``)
 and the two box-pleated FOLD files of Origami Simulator kept with the tests. Printed per
@@ -16,6 +19,7 @@ per stage. Each Miura DOF is checked against the known value (flat 4n - 2, folde
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from collections import defaultdict
 from pathlib import Path
@@ -25,7 +29,18 @@ import numpy as np
 import barhinge as bh
 from barhinge.pattern.io import read
 
-FILES = Path(__file__).resolve().parents[1] / "tests/data/crease-patterns/origami-simulator"
+ROOT = Path(__file__).resolve().parents[1]
+FILES = ROOT / "tests/data/crease-patterns/origami-simulator"
+DOC = ROOT / "docs" / "kinematics.md"
+START, END = "<!-- dof-scale:start -->", "<!-- dof-scale:end -->"
+LINES: list[str] = []
+
+
+def emit(line: str = "") -> None:
+    print(line, flush=True)
+    LINES.append(line)
+
+
 STAGES = ("rank", "local", "actuators", "folded")
 
 
@@ -64,11 +79,10 @@ def row(name: str, cp, repeat: int) -> tuple[bh.DofReport, float, dict[str, floa
     m = rep.mechanism
     split = " | ".join(f"{per[k]:.2f}" for k in STAGES)
     folded = str(m.global_dof) if rep.folded is not None or not rep.flat else "none found"
-    print(
+    emit(
         f"| {name} | {rep.n_variables} | {rep.global_dof} | {folded} | "
         f"{m.gap_ratio:.1e} ({'certain' if m.certain else 'UNCERTAIN'}) | {m.method} | "
-        f"{t:.2f} | {split} |",
-        flush=True,
+        f"{t:.2f} | {split} |"
     )
     return rep, t, per
 
@@ -86,13 +100,14 @@ def main() -> None:
     ap.add_argument("--families", nargs="+", default=["miura"], choices=sorted(FAMILY))
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--no-files", action="store_true")
+    ap.add_argument("--publish", action="store_true", help="rewrite docs/kinematics.md")
     a = ap.parse_args()
-    print(
+    emit(
         "| pattern | creases | DOF flat | DOF folded | gap ratio (folded) | method | median s | "
         + " | ".join(f"{k} s" for k in STAGES)
         + " |"
     )
-    print("|---" * (7 + len(STAGES)) + "|")
+    emit("|---" * (7 + len(STAGES)) + "|")
     fits = {}
     for fam in a.families:
         xs, ts, ps = [], [], defaultdict(list)
@@ -108,11 +123,19 @@ def main() -> None:
     if not a.no_files:
         for f in ("BoxPleatPyramid.fold", "BoxPleatInOutWave.fold"):
             row(f, read(FILES / f), a.repeat)
+    emit()
     for fam, (xs, ts, ps) in fits.items():
         if len(xs) > 1:
             slope = lambda y, x=xs: np.polyfit(np.log(x), np.log(y), 1)[0]  # noqa: E731
             parts = ", ".join(f"{k} ^{slope(ps[k]):.2f}" for k in STAGES)
-            print(f"\n{fam}: time ~ creases^{slope(ts):.2f} ({parts})")
+            emit(f"* {fam}: time ~ creases^{slope(ts):.2f} ({parts})")
+    if a.publish:
+        doc = DOC.read_text()
+        i, j = doc.index(START), doc.index(END)
+        cmd = "python benchmarks/bench_dof.py " + " ".join(sys.argv[1:])
+        body = "\n".join([f"`{cmd}`:", "", *LINES])
+        DOC.write_text(doc[: i + len(START)] + "\n" + body + "\n" + doc[j:])
+        print(f"wrote {DOC}")
 
 
 if __name__ == "__main__":
