@@ -357,10 +357,15 @@ def _report(
     g = rc.n_var - ns.rank
     closure = float(closure_errors(rc, rho).max(initial=0.0))
     flat = bool(np.max(np.abs(rho), initial=0.0) < FLAT_TOL)
-    tick("local and region DOF")
-    local, region = local_dof(rc, rho, tol=tol)
-    tick("actuators")
-    acts = select_actuators(rc, ns, prefer=prefer)
+    try:  # a failing library (an SVD or QR that does not converge) is a named error
+        tick("local and region DOF")
+        local, region = local_dof(rc, rho, tol=tol)
+        tick("actuators")
+        acts = select_actuators(rc, ns, prefer=prefer)
+    except (np.linalg.LinAlgError, MemoryError) as exc:
+        raise RankError(
+            f"local DOF or actuator choice failed: {type(exc).__name__}: {exc}"
+        ) from exc
     note = ""
     if closure > 1e-8:
         note = (
