@@ -4,6 +4,8 @@ docs/kinematics.md between the ``dof-real:start`` / ``dof-real:end`` markers.
 
 Usage: python scripts/dof_table.py [--publish] [--timeout 60]
 
+Also every FOLD file of the pattern catalogue (data/patterns).
+
 Each pattern runs in its own process, as a user would run it (wall time includes Python's
 start-up and the import of barhinge). Real patterns: tests/data/crease-patterns (Origami
 Simulator and the FOLD specification's examples). Stress patterns (written to a temporary
@@ -28,6 +30,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "tests" / "data" / "crease-patterns"
+CATALOGUE = ROOT / "data" / "patterns"
 DOC = ROOT / "docs" / "kinematics.md"
 START, END = "<!-- dof-real:start -->", "<!-- dof-real:end -->"
 
@@ -123,9 +126,14 @@ def cells(label: str, r: dict) -> list[str]:
         folded = "(folded input)"
     else:
         folded = str(fo["global_dof"])
-    extra = f"{holes.group(1)} hole(s)" if holes else ""
+    extra = [f"{holes.group(1)} hole(s)"] if holes else []
+    poly = re.search(r"(\d+) non-triangular panel", st["note"])
+    if poly:
+        extra.append(f"{poly.group(1)} non-triangular panels held rigid")
+    if "disagrees with the M/V assignment" in (fo or {}).get("note", ""):
+        extra.append("folded state against some M/V")
     return [label, str(st["n_variables"]), str(st["counted_dof"]), str(st["global_dof"]),
-            folded, doubt(m), "0", f"{r['s']:.1f}", extra]  # fmt: skip
+            folded, doubt(m), "0", f"{r['s']:.1f}", "; ".join(extra)]  # fmt: skip
 
 
 def table(rows: list[list[str]]) -> str:
@@ -142,20 +150,23 @@ def main() -> None:
     ap.add_argument("--timeout", type=float, default=60.0)
     a = ap.parse_args()
     files = sorted(p for p in DATA.rglob("*") if p.suffix.lower() in (".fold", ".svg"))
+    cat = sorted(CATALOGUE.glob("*.fold"))
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         todo = [(str(p.relative_to(DATA)), [str(p)]) for p in files]
+        todo += [(f"catalogue {p.name}", [str(p)]) for p in cat]
         todo += stress_patterns(Path(tmp))
         for label, args in todo:
             r = run(args, a.timeout)
             rows.append(cells(label, r))
             print("| " + " | ".join(rows[-1]) + " |", flush=True)
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     worst = max(float(r[7]) for r in rows)
     failed = sum(r[6] not in ("0", "2") for r in rows)
     text = (
         f"{table(rows)}\n\n{len(rows)} patterns; the slowest took {worst:.1f} s; "
         f"{failed} ended other than with a report (exit 0) or a one-line input error "
-        f"(exit 2).\n"
+        f"(exit 2). Load average when the run ended: {load:.1f} on {os.cpu_count()} cores.\n"
     )
     print()
     print(text)
