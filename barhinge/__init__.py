@@ -34,6 +34,7 @@ _LAZY = {
     "solve": "barhinge.solve.newton",
     "tangent_stiffness": "barhinge.analysis.stiffness",
     "gaussian_curvature": "barhinge.analysis.curvature",
+    "periodic_cell": "barhinge.analysis.periodic",
 }
 
 __all__ = [

@@ -36,6 +36,7 @@ from barhinge.errors import ConfigError, PatternError
 from barhinge.kinematics.constraints import RigidConstraints
 from barhinge.kinematics.holes import hole_loops
 from barhinge.linalg.nullspace import DENSE_LIMIT, NullSpace, RankError, null_space
+from barhinge.linalg.threads import single_threaded_dense
 from barhinge.pattern.crease import CreasePattern
 
 __all__ = ["DofReport", "dof", "select_actuators", "folded_sample", "system", "closure_errors"]
@@ -170,6 +171,7 @@ class DofReport:
 
 
 # ------------------------------------------------------------------------- public API
+@single_threaded_dense
 def dof(
     cp: CreasePattern,
     state: np.ndarray | Sequence[float] | None = None,

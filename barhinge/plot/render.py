@@ -3,16 +3,19 @@
 PyVista (VTK) is imported lazily, only when a picture is made. Off-screen rendering uses EGL
 (``VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow``; Mesa's software renderer is enough). On a
 machine without a GL stack VTK crashes the process instead of raising, so the first render
-probes VTK once in a subprocess (result cached for the session) and, if that fails, falls back
-to a matplotlib 3-D render (``backend="auto"``) or raises :class:`RenderError`
-(``backend="pyvista"``).
+probes VTK in a subprocess (a success is remembered on disk, per machine set-up) and, if that
+fails, falls back to a matplotlib 3-D render (``backend="auto"``) or raises
+:class:`RenderError` (``backend="pyvista"``).
 
 Colours follow the crease-pattern drawings: valley folds (rho > 0) blue, mountain folds red.
 """
 
 from __future__ import annotations
 
+import ctypes.util
 import functools
+import importlib.metadata
+import json
 import logging
 import os
 import subprocess
@@ -71,13 +74,24 @@ def _set_egl_env() -> None:
 
 @functools.cache
 def can_render_offscreen() -> bool:
-    """True if VTK can render off-screen here (probed once in a subprocess, then cached).
+    """True if VTK can render off-screen here.
 
-    Set ``BARHINGE_OFFSCREEN=1`` (or ``0``) to skip the probe (a few seconds per process).
+    Probed in a subprocess (VTK may crash the process it runs in); a success is remembered
+    on disk (``$XDG_CACHE_HOME/barhinge/offscreen.json``, keyed by the Python, the VTK
+    version, the EGL library and the environment variables that choose the GL stack), so a
+    machine is probed once, not on every run. Set ``BARHINGE_OFFSCREEN=1`` (or ``0``) to skip
+    the probe.
     """
     forced = os.environ.get("BARHINGE_OFFSCREEN", "").strip()
     if forced in ("0", "1"):
         return forced == "1"
+    key = _probe_key()
+    cache = _probe_cache_file()
+    try:
+        if json.loads(cache.read_text()).get(key) is True:
+            return True
+    except (OSError, ValueError, AttributeError):
+        pass
     env = {**os.environ, **_EGL}
     env.setdefault("VTK_DEFAULT_OPENGL_WINDOW", _EGL["VTK_DEFAULT_OPENGL_WINDOW"])
     try:
@@ -89,7 +103,55 @@ def can_render_offscreen() -> bool:
         return False
     if r.returncode != 0:
         log.warning("off-screen rendering unavailable (probe exit %d)", r.returncode)
-    return r.returncode == 0
+        return False
+    _remember_probe(cache, key)
+    return True
+
+
+#: environment variables that choose the GL stack VTK renders with
+_GL_ENV = (
+    "DISPLAY",
+    "WAYLAND_DISPLAY",
+    "VTK_DEFAULT_OPENGL_WINDOW",
+    "LIBGL_ALWAYS_SOFTWARE",
+    "EGL_PLATFORM",
+    "MESA_GL_VERSION_OVERRIDE",
+    "PYVISTA_OFF_SCREEN",
+)
+
+
+def _probe_key() -> str:
+    """What a cached probe result depends on: the Python, VTK, the EGL library file and the
+    GL environment."""
+    try:
+        vtk = importlib.metadata.version("vtk")
+    except importlib.metadata.PackageNotFoundError:
+        vtk = "none"
+    egl = ctypes.util.find_library("EGL") or "none"
+    parts = [sys.executable, vtk, egl, *(f"{k}={os.environ.get(k, '')}" for k in _GL_ENV)]
+    return "|".join(parts)
+
+
+def _probe_cache_file() -> Path:
+    root = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(root) / "barhinge" / "offscreen.json"
+
+
+def _remember_probe(cache: Path, key: str) -> None:
+    """Record a successful probe (best effort: an unwritable cache costs one probe per run)."""
+    try:
+        try:
+            known = json.loads(cache.read_text())
+            known = known if isinstance(known, dict) else {}
+        except (OSError, ValueError):
+            known = {}
+        known[key] = True
+        cache.parent.mkdir(parents=True, exist_ok=True)
+        tmp = cache.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_text(json.dumps(known, indent=1))
+        os.replace(tmp, cache)
+    except OSError as exc:
+        log.debug("could not cache the off-screen probe: %s", exc)
 
 
 def _backend(backend: str) -> str:
