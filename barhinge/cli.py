@@ -393,8 +393,24 @@ def dof(
             f"--png {png}: expected a picture file ending in "
             f"{', '.join(_PICTURE_SUFFIXES[:-1])} or {_PICTURE_SUFFIXES[-1]}"
         )
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
     cp = _dof_pattern(pattern)
-    rep = compute_dof(cp, triangulated=triangulated, prefer=prefer)
+    bar = Progress(
+        TextColumn("[bold]dof[/] {task.description}"),
+        BarColumn(),
+        TimeElapsedColumn(),
+        console=err_console,
+        disable=as_json,
+        transient=True,
+    )
+    with bar:
+        task = bar.add_task("", total=None)
+
+        def show(stage: str, done: int, total: int) -> None:
+            bar.update(task, description=stage, completed=done, total=total)
+
+        rep = compute_dof(cp, triangulated=triangulated, prefer=prefer, progress=show)
     if png is not None:
         from barhinge.plot.dof import draw_dof
 
