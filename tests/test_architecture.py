@@ -45,7 +45,17 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("analysis", ["barhinge.analysis", "barhinge.analysis.*"]),
     # solve/outputs.py writes the result folder of a solved scene: an output module that lives
     # in solve/ by name only (nothing in the solver imports it)
-    ("output", ["barhinge.solve.outputs", "barhinge.io", "barhinge.plot", "barhinge.plot.*"]),
+    (
+        "output",
+        [
+            "barhinge.solve.outputs",
+            "barhinge.io",
+            "barhinge.plot",
+            "barhinge.plot.*",
+            "barhinge.view",
+            "barhinge.view.*",
+        ],
+    ),
     ("apps", ["barhinge.verify", "barhinge.sweep"]),
     ("cli", ["barhinge.cli", "barhinge.__main__"]),
     ("api", ["barhinge"]),
