@@ -258,8 +258,9 @@ def view_data(
         V = cp.vertices3d
         L0 = np.linalg.norm(V[bars[:, 1]] - V[bars[:, 0]], axis=1)
         X = X[:, : cp.n_vertices]
-    if moment is None and len(path.actuator_edges):
-        moment = np.full(path.fold_angles_deg.shape, np.nan)
+    if len(path.actuator_edges):  # an actuator's moment: what drives it (the multiplier)
+        if moment is None:
+            moment = np.full(path.fold_angles_deg.shape, np.nan)
         moment[:, path.actuator_edges] = path.actuator_moments
     if fixed is None:
         fixed = _supports_from_reactions(path)

@@ -27,7 +27,9 @@ _CSP = (
 
 
 def _b64(a: np.ndarray, dtype: Any) -> str:
-    return base64.b64encode(np.ascontiguousarray(a, dtype=np.dtype(dtype).newbyteorder("<")).tobytes()).decode()
+    return base64.b64encode(
+        np.ascontiguousarray(a, dtype=np.dtype(dtype).newbyteorder("<")).tobytes()
+    ).decode()
 
 
 def _clean(v: Any) -> Any:
