@@ -9,11 +9,11 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
+from barhinge import results as _results
 from barhinge._version import __version__ as __version__
 from barhinge.actuators import Actuators
 from barhinge.errors import BarhingeError, ConfigError, ConvergenceError, PatternError
 from barhinge.pattern.crease import CreasePattern
-from barhinge import results as _results
 from barhinge.results import FoldPath
 
 # name -> module that defines it (imported on first use)

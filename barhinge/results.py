@@ -11,8 +11,8 @@ import dataclasses
 import json
 import os
 import secrets
-from pathlib import Path
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np

@@ -83,7 +83,15 @@ def test_foldpath_rich_display(run):
 def browser():
     if not (CHROMIUM and DRIVER):
         pytest.skip("chromium / chromedriver not installed (.ci/run installs them)")
-    webdriver = pytest.importorskip("selenium.webdriver")
+    pytest.importorskip("selenium.webdriver")
+    drv = open_browser()
+    yield drv
+    drv.quit()
+
+
+def open_browser():
+    """Headless Chromium (Debian's chromium + chromium-driver) with the network off."""
+    from selenium import webdriver
     from selenium.webdriver.chrome.service import Service
 
     opt = webdriver.ChromeOptions()
@@ -99,8 +107,7 @@ def browser():
         "Network.emulateNetworkConditions",
         {"offline": True, "latency": 0, "downloadThroughput": 0, "uploadThroughput": 0},
     )
-    yield drv
-    drv.quit()
+    return drv
 
 
 def _canvas(drv, element_id: str) -> np.ndarray:
@@ -117,7 +124,7 @@ def _open(drv, html: Path):
 
 
 def shots(drv, html: Path, folder: Path | None = None) -> dict[str, np.ndarray]:
-    """The test's pictures; also written to ``folder`` (docs/img) by scripts/viewer_screenshots.py."""
+    """The test's pictures (also saved as docs/img/viewer.png by scripts/viewer_screenshots.py)."""
     _open(drv, html)
     out = {}
     drv.execute_script("barhingeViewer.setMode('fold'); barhingeViewer.setState(0)")
