@@ -59,8 +59,10 @@ def main() -> None:
     tv = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(tv)
     drv = tv.open_browser()
+    head = ("case", "nodes", "states", "MB", "write s", "open s", "play s/state")
     print(
-        f"{'case':<28} {'nodes':>7} {'states':>6} {'MB':>7} {'write s':>8} {'open s':>7} {'play s/state':>12}"
+        f"{head[0]:<28} "
+        + " ".join(f"{h:>{w}}" for h, w in zip(head[1:], (7, 6, 7, 8, 7, 12), strict=True))
     )
     try:
         with tempfile.TemporaryDirectory() as tmp:
