@@ -42,13 +42,16 @@ def write_pictures(
     kw: dict[str, Any] = {"model": model, "pattern": cp if model is None else None}
     fa = fold_path.fold_angles_deg[-1] if model is None else None
     done: dict[str, Path] = {}
+    last = fold_path.n_states - 1
+    scene = fold_path.meta.get("scene") or name
+    title = f"{scene}: state {last} of {last}" + ("" if fold_path.converged else " (stopped)")
     done["png"] = render.render_state(
-        fold_path.X[-1], out / f"{name}.png", fold_angles_deg=fa, **kw
+        fold_path.X[-1], out / f"{name}.png", fold_angles_deg=fa, title=title, **kw
     )
     if model is not None:
         for arr in extra_arrays:
             done[arr] = render.render_state(
-                fold_path.X[-1], out / f"{name}_{arr}.png", scalars=arr, **kw
+                fold_path.X[-1], out / f"{name}_{arr}.png", scalars=arr, title=title, **kw
             )
     done["charts"] = out / f"{name}_charts.png"
     charts.summary_figure(fold_path, done["charts"])

@@ -139,7 +139,26 @@ def _pick(d: StateData, scalars: str | np.ndarray | None) -> tuple[str, str, np.
     )
 
 
+def nice_limits(lo: float, hi: float, max_ticks: int = 7) -> tuple[float, float, int]:
+    """Limits widened to round numbers and the number of evenly spaced ticks between them,
+    each tick a multiple of a step of 1, 2, 2.5 or 5 times a power of ten (at most
+    ``max_ticks`` ticks)."""
+    if not hi > lo:
+        lo, hi = lo - 1.0, lo + 1.0
+    raw = (hi - lo) / (max_ticks - 1)
+    p = 10.0 ** np.floor(np.log10(raw))
+    for k in (1.0, 2.0, 2.5, 5.0, 10.0, 20.0):
+        step = k * p
+        a, b = np.floor(lo / step + 1e-9) * step, np.ceil(hi / step - 1e-9) * step
+        n = int(round((b - a) / step)) + 1
+        if n <= max_ticks:
+            return float(a), float(b), n
+    return lo, hi, 2
+
+
 def _clim(name: str, v: np.ndarray | None, clim: Sequence[float] | None) -> tuple[float, float]:
+    """Colour limits: ``clim`` as given, else the data's range widened to round numbers
+    (:func:`nice_limits`; symmetric about 0 for signed arrays such as fold angles)."""
     if clim is not None:
         return float(clim[0]), float(clim[1])
     finite = v[np.isfinite(v)] if v is not None else np.zeros(0)
@@ -148,9 +167,10 @@ def _clim(name: str, v: np.ndarray | None, clim: Sequence[float] | None) -> tupl
     sym = ARRAYS.get(name, ("", "", False))[2]
     if sym:
         m = float(np.abs(finite).max()) or 1.0
-        return (-m, m)
+        lo, hi, _ = nice_limits(-m, m)
+        return (-max(-lo, hi), max(-lo, hi))
     lo, hi = float(finite.min()), float(finite.max())
-    return (lo, hi) if hi > lo else (lo - 1.0, lo + 1.0)
+    return nice_limits(lo, hi)[:2] if hi > lo else (lo - 1.0, lo + 1.0)
 
 
 # ---------------------------------------------------------------------------- pyvista
@@ -208,8 +228,10 @@ def _add_state(p, meshes, where: str, name: str, cmap, clim, line_width: float, 
     label = label or default_label
     cmap = cmap or default_cmap
     fs = max(10, int(round(p.window_size[1] / 45)))
+    lo, hi = clim
+    n_labels = nice_limits(lo, hi, 7 if p.window_size[0] >= 800 else 5)[2]
     sbar = {
-        "n_labels": 5 if p.window_size[0] >= 800 else 3,
+        "n_labels": n_labels,  # on the round numbers of nice_limits when clim is theirs
         "title": label,
         "vertical": False,
         "position_x": 0.25,

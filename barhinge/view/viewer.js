@@ -2,8 +2,11 @@
 // Data: window.BH (JSON written by barhinge.view); arrays are base64 little-endian typed arrays.
 "use strict";
 (function () {
+  const T0 = performance.now(), timing = {};
   const D = JSON.parse(document.getElementById("bh-data").textContent);
+  timing.parse = performance.now() - T0;
   function dec(s, T) {
+    if (Uint8Array.fromBase64) return new T(Uint8Array.fromBase64(s).buffer);
     const b = atob(s), u = new Uint8Array(b.length);
     for (let i = 0; i < b.length; i++) u[i] = b.charCodeAt(i);
     return new T(u.buffer);
@@ -23,6 +26,7 @@
   const ACT = new Set(D.actuators);
   const ASSIGN = D.assignment;
   const T = TRI.length / 3, B = BARS.length / 2, E = CR.length / 2;
+  timing.decode = performance.now() - T0;
 
   // ---------------------------------------------------------------- fields from positions
   const boundary = new Uint8Array(N);
@@ -116,9 +120,11 @@
   function range(m) {
     if (ranges[m]) return ranges[m];
     let lo = Infinity, hi = -Infinity;
-    const step = Math.max(1, Math.floor(S / 12));
-    for (let s = 0; s < S; s += step) for (const v of [MODES[m].f(s), MODES[m].f(S - 1)]) for (const x of v)
-      if (Number.isFinite(x)) { lo = Math.min(lo, x); hi = Math.max(hi, x); }
+    const step = Math.max(1, Math.floor(S / 6)), states = [];
+    for (let s = 0; s < S; s += step) states.push(s);
+    if (states[states.length - 1] !== S - 1) states.push(S - 1);
+    const scan = (v) => { for (const x of v) if (Number.isFinite(x)) { if (x < lo) lo = x; if (x > hi) hi = x; } };
+    if (m === "fold") scan(FOLD); else for (const s of states) scan(MODES[m].f(s));
     if (!Number.isFinite(lo)) { lo = 0; hi = 1; }
     if (MODES[m].div) { const a = Math.max(Math.abs(lo), Math.abs(hi)) || 1; lo = -a; hi = a; }
     if (hi <= lo) hi = lo + 1;
@@ -321,20 +327,38 @@
     const ox = (w - s * (fhi[0] - flo[0])) / 2, oy = (h - s * (fhi[1] - flo[1])) / 2;
     return (i) => [ox + s * (FLAT[2 * i] - flo[0]), h - oy - s * (FLAT[2 * i + 1] - flo[1])];
   }
+  let cpBase = null;  // the pattern drawn once (one path per style); hover redraws one crease
+  function strokeCrease(g, tr, e, hot) {
+    const [x0, y0] = tr(CR[2 * e]), [x1, y1] = tr(CR[2 * e + 1]);
+    g.moveTo(x0, y0); g.lineTo(x1, y1);
+  }
   function drawCP() {
     const dpr = window.devicePixelRatio || 1, w = cpc.clientWidth, h = cpc.clientHeight;
-    cpc.width = Math.round(w * dpr); cpc.height = Math.round(h * dpr);
-    const g = cpc.getContext("2d"); g.setTransform(dpr, 0, 0, dpr, 0, 0); g.clearRect(0, 0, w, h);
+    const W = Math.round(w * dpr), H = Math.round(h * dpr);
     const tr = cpTransform();
-    for (let e = 0; e < E; e++) {
-      const [x0, y0] = tr(CR[2 * e]), [x1, y1] = tr(CR[2 * e + 1]);
-      const col = e === V.hover ? [1, 0.75, 0] : ACT.has(e) ? [0.1, 0.7, 0.2] : MV[ASSIGN[e]] || MV.U;
-      g.strokeStyle = `rgb(${col.map((x) => Math.round(255 * x)).join(",")})`;
-      g.lineWidth = e === V.hover ? 4 : ACT.has(e) ? 2.5 : 1.4;
-      g.setLineDash(ASSIGN[e] === "M" ? [6, 3] : []);
-      g.beginPath(); g.moveTo(x0, y0); g.lineTo(x1, y1); g.stroke();
+    if (!cpBase || cpBase.width !== W || cpBase.height !== H) {
+      cpBase = document.createElement("canvas"); cpBase.width = W; cpBase.height = H;
+      const g = cpBase.getContext("2d"); g.setTransform(dpr, 0, 0, dpr, 0, 0);
+      const groups = new Map();
+      for (let e = 0; e < E; e++) {
+        const k = ACT.has(e) ? "act" : ASSIGN[e];
+        if (!groups.has(k)) groups.set(k, []);
+        groups.get(k).push(e);
+      }
+      for (const [k, list] of groups) {
+        const col = k === "act" ? [0.1, 0.7, 0.2] : MV[k] || MV.U;
+        g.strokeStyle = `rgb(${col.map((x) => Math.round(255 * x)).join(",")})`;
+        g.lineWidth = k === "act" ? 2.5 : E > 5000 ? 0.6 : 1.4;
+        g.setLineDash(k === "M" && E <= 5000 ? [6, 3] : []);
+        g.beginPath(); for (const e of list) strokeCrease(g, tr, e); g.stroke();
+      }
     }
-    g.setLineDash([]);
+    cpc.width = W; cpc.height = H;
+    const g = cpc.getContext("2d"); g.drawImage(cpBase, 0, 0);
+    if (V.hover >= 0) {
+      g.setTransform(dpr, 0, 0, dpr, 0, 0); g.strokeStyle = "rgb(255,191,0)"; g.lineWidth = 4;
+      g.beginPath(); strokeCrease(g, tr, V.hover); g.stroke();
+    }
   }
   function nearestCrease(mx, my) {
     const tr = cpTransform(); let best = -1, bd = 8;
@@ -451,13 +475,19 @@
     sum.appendChild(tr);
   }
   if (gl) setup();
-  drawCP(); setMode(E ? "fold" : "displacement"); setState(S - 1);
+  timing.setup = performance.now() - T0;
+  drawCP();
+  timing.pattern = performance.now() - T0;
+  setMode(E ? "fold" : "displacement");
+  timing.mode = performance.now() - T0;
+  setState(S - 1);
+  timing.ready = performance.now() - T0;
   V.ready = true;
   // for tests and scripts: drive the viewer and read what it shows
   window.barhingeViewer = {
     get state() { return V.state; }, get mode() { return V.mode; }, get ready() { return V.ready; },
     modes: Object.keys(MODES), setState, setMode, field: (m, s) => Array.from(MODES[m].f(s)),
     creasePoint: (e) => { const tr = cpTransform(), a = tr(CR[2 * e]), b = tr(CR[2 * e + 1]); return [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2]; },
-    camera: cam,
+    camera: cam, timing,
   };
 })();
