@@ -186,5 +186,5 @@ def test_viewer_in_chromium(run, browser, tmp_path):
     tip = browser.find_element("id", "tip").text
     assert f"crease {e} (actuator)" in tip
     assert f"assignment {scene.model.pattern.assignment[e]}" in tip
-    assert f"fold angle {path.fold_angles_deg[s, e]:.2f}" in tip
+    assert f"fold angle {np.rint(path.fold_angles_deg[s, e] * 100) / 100:.2f}" in tip
     assert "moment" in tip and "moment \u2013" not in tip

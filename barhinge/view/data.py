@@ -22,6 +22,7 @@ import numpy as np
 from barhinge.errors import ConfigError
 from barhinge.io import StateData, read_state_vtu, state_data
 from barhinge.pattern.fold import read_fold, read_fold_path
+from barhinge.plot.charts import control_axis
 from barhinge.results import FoldPath
 
 __all__ = ["ViewData", "load_view_data", "node_energy_density", "view_data"]
@@ -58,6 +59,9 @@ class ViewData:
         Per-state numbers for the charts (load factor, energies, actuator angles, moments).
     summary : dict
         Summary numbers of the run (JSON-serialisable).
+    x_label : str
+        The series the charts use as x-axis: the control of the path
+        (:func:`barhinge.plot.charts.control_axis`).
     """
 
     title: str
@@ -76,6 +80,7 @@ class ViewData:
     actuators: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0, int))
     series: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
     summary: dict[str, Any] = dataclasses.field(default_factory=dict)
+    x_label: str = "state"
 
     @property
     def n_states(self) -> int:
@@ -134,6 +139,8 @@ def _supports_from_reactions(path: FoldPath) -> np.ndarray | None:
 
 def _series(path: FoldPath) -> dict[str, np.ndarray]:
     out: dict[str, np.ndarray] = {"state": np.arange(path.n_states, dtype=float)}
+    x, label = control_axis(path)
+    out[label] = x
     if np.ptp(path.load_factor) > 0:
         out["load factor"] = path.load_factor
     for name in ("energy_bars", "energy_bend", "energy_fold"):
@@ -289,6 +296,7 @@ def view_data(
         actuators=np.asarray(path.actuator_edges, np.int64),
         series=_series(path),
         summary=_summary(path, summary),
+        x_label=control_axis(path)[1],
     )
 
 
@@ -320,6 +328,7 @@ def _without_pattern(path: FoldPath, title: str | None) -> ViewData:
         fixed=_supports_from_reactions(path),
         series=_series(path),
         summary=_summary(path),
+        x_label=control_axis(path)[1],
     )
 
 

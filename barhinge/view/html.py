@@ -41,21 +41,16 @@ def _clean(v: Any) -> Any:
 
 
 def _charts(d: ViewData) -> tuple[str, list[dict[str, Any]]]:
-    """The x-axis (the control: actuator angle, load factor or state) and the chart groups."""
+    """The x-axis (the control, as in the static charts) and the chart groups."""
     keys = list(d.series)
     angles = [k for k in keys if k.startswith("actuator") and k.endswith("angle (deg)")]
     moments = [k for k in keys if k.startswith("actuator") and k.endswith("moment")]
-    if angles:
-        x = angles[0]
-    elif "load factor" in d.series:
-        x = "load factor"
-    else:
-        x = "state"
+    x = d.x_label if d.x_label in d.series else "state"
     charts = []
     energy = [k for k in keys if k.startswith("energy")]
     if energy:
         charts.append({"title": "stored energy", "keys": energy})
-    if len(angles) > 1 or (angles and x != angles[0]):
+    if angles:
         charts.append({"title": "actuator fold angles (deg)", "keys": angles})
     if moments:
         charts.append({"title": "actuator moments", "keys": moments})
@@ -81,7 +76,9 @@ def viewer_payload(d: ViewData) -> dict[str, Any]:
         "creases": _b64(d.creases, np.uint32),
         "assignment": [str(a) for a in d.assignment],
         "flat": _b64(d.flat, np.float32),
-        "fold_deg": _b64(d.fold_deg, np.float32),
+        # fold angles in hundredths of a degree (int16): half the size of float32, exact
+        # to the two decimals the viewer shows
+        "fold_cdeg": _b64(np.rint(np.clip(np.nan_to_num(d.fold_deg), -327, 327) * 100), np.int16),
         "moment": None if d.moment is None else _b64(d.moment, np.float32),
         "energy_density": None if d.energy_density is None else _b64(d.energy_density, np.float32),
         "fixed": None if d.fixed is None or not d.fixed.any() else _b64(d.fixed, np.uint8),
@@ -116,7 +113,12 @@ def viewer_html(d: ViewData) -> str:
 <main>
 <section id="view3d"><canvas id="gl"></canvas><canvas id="bar"></canvas>
 <p class="hint">drag: orbit &middot; right-drag or shift-drag: pan &middot; wheel: zoom &middot;
-green: actuators &middot; black dots: supports &middot; purple: loads</p></section>
+green: actuators &middot; black dots: supports &middot; purple: loads</p>
+<nav><button id="play">&#9654; play</button>
+<input id="state" type="range" min="0" max="0" step="1" value="0">
+<span id="statelabel"></span>
+<label>colour by <select id="mode"></select></label></nav>
+<div id="charts">{canvases}</div></section>
 <aside>
 <h2>Crease pattern</h2>
 <canvas id="cp"></canvas>
@@ -124,11 +126,6 @@ green: actuators &middot; black dots: supports &middot; purple: loads</p></secti
 <h2>Run</h2><table id="summary"></table>
 </aside>
 </main>
-<nav><button id="play">&#9654; play</button>
-<input id="state" type="range" min="0" max="0" step="1" value="0">
-<span id="statelabel"></span>
-<label>colour by <select id="mode"></select></label></nav>
-<section id="charts">{canvases}</section>
 <div id="tip"></div>
 <script type="application/json" id="bh-data">{data}</script>
 <script>{_asset("viewer.js")}</script>

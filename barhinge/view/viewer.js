@@ -17,7 +17,7 @@
   const BARS = dec(D.bars, Uint32Array);          // B*2
   const L0 = dec(D.bar_L0, Float32Array);
   const CR = dec(D.creases, Uint32Array);         // E*2
-  const FOLD = dec(D.fold_deg, Float32Array);     // S*E
+  const FOLD = Float32Array.from(dec(D.fold_cdeg, Int16Array), (q) => q / 100);  // S*E, deg
   const MOM = D.moment ? dec(D.moment, Float32Array) : null;
   const EN = D.energy_density ? dec(D.energy_density, Float32Array) : null;
   const FLAT = dec(D.flat, Float32Array);         // Nv*2
@@ -225,24 +225,28 @@
     return c;
   }
   function lineData(P, s) {
-    const p = [], c = [];
-    const push = (i, col) => { p.push(P[3 * i], P[3 * i + 1], P[3 * i + 2]); c.push(...col); };
+    const n = 2 * lineIdx.length + 2 * loadN.length + supp.length;
+    const p = new Float32Array(3 * n), c = new Float32Array(3 * n);
+    let k = 0;
+    const put = (x, y, z, col) => { p[3 * k] = x; p[3 * k + 1] = y; p[3 * k + 2] = z; c[3 * k] = col[0]; c[3 * k + 1] = col[1]; c[3 * k + 2] = col[2]; k++; };
+    const node = (i, col) => put(P[3 * i], P[3 * i + 1], P[3 * i + 2], col);
+    const amax = V.mode === "fold" ? range("fold")[1] : 1;
     for (const e of lineIdx) {
       let col = MV[ASSIGN[e]] || MV.U;
-      if (V.mode === "fold" && ASSIGN[e] !== "B") { const f = FOLD[s * E + e], amax = range("fold")[1]; col = cmap("fold", 0.5 + 0.5 * Math.sign(f) * (0.35 + 0.65 * Math.min(1, Math.abs(f) / amax))); }
+      if (V.mode === "fold" && ASSIGN[e] !== "B") { const f = FOLD[s * E + e]; col = cmap("fold", 0.5 + 0.5 * Math.sign(f) * (0.35 + 0.65 * Math.min(1, Math.abs(f) / amax))); }
       if (ACT.has(e)) col = [0.1, 0.7, 0.2];
       if (e === V.hover) col = [1, 0.75, 0];
-      push(CR[2 * e], col); push(CR[2 * e + 1], col);
+      node(CR[2 * e], col); node(CR[2 * e + 1], col);
     }
-    const nl = p.length / 3, lp = p, lc = c;
+    const nl = k, purple = [0.55, 0.1, 0.6];
     for (const i of loadN) {  // load arrows: a segment along the load, 0.15 radius long at the largest
       const f = 0.15 * radius / maxLoad;
-      lp.push(P[3 * i], P[3 * i + 1], P[3 * i + 2], P[3 * i] + f * LOADS[3 * i], P[3 * i + 1] + f * LOADS[3 * i + 1], P[3 * i + 2] + f * LOADS[3 * i + 2]);
-      lc.push(0.55, 0.1, 0.6, 0.55, 0.1, 0.6);
+      node(i, purple);
+      put(P[3 * i] + f * LOADS[3 * i], P[3 * i + 1] + f * LOADS[3 * i + 1], P[3 * i + 2] + f * LOADS[3 * i + 2], purple);
     }
-    const nLoad = p.length / 3 - nl;
-    for (const i of supp) { lp.push(P[3 * i], P[3 * i + 1], P[3 * i + 2]); lc.push(0, 0, 0); }
-    return { p: new Float32Array(lp), c: new Float32Array(lc), nl, nLoad, np: supp.length };
+    const nLoad = k - nl;
+    for (const i of supp) node(i, [0, 0, 0]);
+    return { p, c, nl, nLoad, np: supp.length };
   }
 
   function matrix() {
