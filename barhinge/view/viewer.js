@@ -1,6 +1,10 @@
 // barhinge fold-path viewer: WebGL2 sheet, 2-D crease pattern, charts. No network, no library.
 // Data: window.BH (JSON written by barhinge.view); arrays are base64 little-endian typed arrays.
 "use strict";
+window.addEventListener("error", (e) => {  // say it on the page too, not only in the console
+  const m = document.getElementById("msg");
+  if (m) m.textContent = `viewer error: ${e.message}`;
+});
 (function () {
   const T0 = performance.now(), timing = {};
   const D = JSON.parse(document.getElementById("bh-data").textContent);
