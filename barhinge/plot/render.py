@@ -419,6 +419,23 @@ def _render_mpl(d, where, name, values, cmap, clim, path, window_size, view, tit
     return path
 
 
+def _add_supports_and_loads(
+    p, X: np.ndarray, fixed: np.ndarray | None, loads: np.ndarray | None
+) -> None:
+    """Black dots at the supported nodes, purple arrows along the loads."""
+    size = float(np.linalg.norm(np.ptp(X, axis=0))) or 1.0
+    if fixed is not None:
+        f = np.asarray(fixed, bool).reshape(-1, 3)[: len(X)].any(axis=1)
+        if f.any():
+            p.add_points(X[f], color="black", point_size=12, render_points_as_spheres=True)
+    if loads is not None:
+        F = np.asarray(loads, float).reshape(-1, 3)[: len(X)]
+        mag = np.linalg.norm(F, axis=1)
+        on = mag > 0
+        if on.any():
+            p.add_arrows(X[on], F[on], mag=0.08 * size / mag.max(), color="#8e44ad")
+
+
 # ------------------------------------------------------------------------------ API
 def render_state(
     X: np.ndarray,
@@ -435,6 +452,8 @@ def render_state(
     title: str | None = None,
     label: str | None = None,
     backend: str = "auto",
+    fixed: np.ndarray | None = None,
+    loads: np.ndarray | None = None,
 ) -> Path:
     """Render one state to a PNG, coloured by a named array.
 
@@ -458,6 +477,11 @@ def render_state(
     title, label : str, optional
         Title of the picture; title of the colour bar (default: the array's name and unit).
     backend : {"auto", "pyvista", "matplotlib"}
+    fixed : (n_nodes, 3) bool, optional
+        Supports: nodes with a fixed DOF are drawn as black dots (pyvista backend).
+    loads : (n_nodes, 3) float, optional
+        Loads: purple arrows at the loaded nodes, the largest 8 % of the state's size long
+        (pyvista backend).
     """
     path = Path(path)
     d = state_data(
@@ -475,6 +499,7 @@ def render_state(
         meshes = _polydata(d)
         _assign(meshes, d, where, name, values)
         bar = _add_state(p, meshes, where, name, cmap, lim, line_width=2.0, label=label)
+        _add_supports_and_loads(p, d.points, fixed, loads)
         _camera(p, _bounds(d.points[None]), view)
         _fit(p, bottom=0.16 if bar is not None else 0.0, top=0.08 if title else 0.0)
         _scalar_bar(p, bar)

@@ -39,3 +39,28 @@ def test_control_axis():
     x, label = control_axis(_path([0, 0, 0], "load", load=[0, 0.5, 1]))
     assert label == "load factor" and x[-1] == 1
     assert control_axis(_path([0, 0, 0], None))[1] == "step"
+
+
+def test_supports_and_loads_are_drawn(tmp_path):
+    """Black dots at supports and arrows at loads: the picture changes at those nodes only."""
+    from PIL import Image
+
+    from barhinge.patterns import miura
+    from barhinge.plot import render
+
+    if not render.can_render_offscreen():
+        pytest.skip("no off-screen rendering")
+    cp = miura(nx=2, ny=2, fold=30.0)
+    X = cp.vertices3d
+    fixed = np.zeros((len(X), 3), bool)
+    fixed[0] = True
+    loads = np.zeros((len(X), 3))
+    loads[len(X) - 1, 2] = -1.0
+    kw = {"pattern": cp, "window_size": (400, 300), "backend": "pyvista"}
+    a = render.render_state(X, tmp_path / "a.png", **kw)
+    b = render.render_state(X, tmp_path / "b.png", fixed=fixed, loads=loads, **kw)
+    A = np.asarray(Image.open(a).convert("RGB"), float)
+    B = np.asarray(Image.open(b).convert("RGB"), float)
+    changed = np.abs(A - B).sum(axis=2) > 30
+    assert 0 < changed.mean() < 0.1
+    assert (B[changed].sum(axis=1) < A[changed].sum(axis=1)).mean() > 0.5  # dark marks
