@@ -817,6 +817,30 @@ def render(
             console.print(f"[green]{k:>6}[/] {v}", highlight=False)
 
 
+# --- commands: view (interactive HTML) ---
+
+
+@app.command()
+def view(
+    path: Annotated[
+        Path, typer.Argument(help="Result folder, fold_path.npz or FOLD file with frames.")
+    ],
+    output: Annotated[
+        Path | None,
+        typer.Option("--output", "-o", help="HTML file (default: viewer.html beside PATH)."),
+    ] = None,
+) -> None:
+    """Write the fold path as one interactive HTML file that works offline."""
+    from barhinge.io import MANIFEST, add_to_manifest
+    from barhinge.view import write_viewer
+
+    default = path / "viewer.html" if path.is_dir() else path.with_name(f"{path.stem}.html")
+    out = write_viewer(path, output if output is not None else default)
+    if output is None and path.is_dir() and (path / MANIFEST).is_file():
+        add_to_manifest(path, [out])  # a result folder lists the viewer as its own
+    console.print(f"[green]viewer[/] {out}", highlight=False)
+
+
 # --- commands: study (sweeps) ---
 
 

@@ -50,6 +50,7 @@ __all__ = [
     "atomic_file",
     "check_output_folder",
     "read_manifest",
+    "read_state_vtu",
     "result_folder",
     "state_data",
     "state_mesh",
@@ -257,6 +258,26 @@ def write_state_vtu(path: str | Path, X: np.ndarray, **kwargs: Any) -> Path:
     path = Path(path)
     state_mesh(X, **kwargs).write(path)
     return path
+
+
+def read_state_vtu(path: str | Path) -> StateData:
+    """Read a ``.vtu`` file written by :func:`write_state_vtu` back into a :class:`StateData`."""
+    import meshio
+
+    try:
+        m = meshio.read(Path(path))
+        blocks = [c.type for c in m.cells]
+        t, li = blocks.index("triangle"), blocks.index("line")
+        return StateData(
+            points=np.asarray(m.points, float),
+            triangles=np.asarray(m.cells[t].data, np.int64),
+            lines=np.asarray(m.cells[li].data, np.int64),
+            point_data={k: np.asarray(v, float) for k, v in m.point_data.items()},
+            triangle_data={k: np.asarray(v[t], float) for k, v in m.cell_data.items()},
+            line_data={k: np.asarray(v[li], float) for k, v in m.cell_data.items()},
+        )
+    except (OSError, ValueError, KeyError, IndexError) as exc:
+        raise ConfigError(f"{path} is not a state written by barhinge ({exc})") from None
 
 
 @contextlib.contextmanager

@@ -53,6 +53,8 @@ LAYERS: list[tuple[str, list[str]]] = [
             "barhinge.modes_vtu",
             "barhinge.plot",
             "barhinge.plot.*",
+            "barhinge.view",
+            "barhinge.view.*",
         ],
     ),
     ("apps", ["barhinge.verify", "barhinge.sweep"]),

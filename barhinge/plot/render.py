@@ -201,7 +201,26 @@ def _pick(d: StateData, scalars: str | np.ndarray | None) -> tuple[str, str, np.
     )
 
 
+def nice_limits(lo: float, hi: float, max_ticks: int = 7) -> tuple[float, float, int]:
+    """Limits widened to round numbers and the number of evenly spaced ticks between them,
+    each tick a multiple of a step of 1, 2, 2.5 or 5 times a power of ten (at most
+    ``max_ticks`` ticks)."""
+    if not hi > lo:
+        lo, hi = lo - 1.0, lo + 1.0
+    raw = (hi - lo) / (max_ticks - 1)
+    p = 10.0 ** np.floor(np.log10(raw))
+    for k in (1.0, 2.0, 2.5, 5.0, 10.0, 20.0):
+        step = k * p
+        a, b = np.floor(lo / step + 1e-9) * step, np.ceil(hi / step - 1e-9) * step
+        n = int(round((b - a) / step)) + 1
+        if n <= max_ticks:
+            return float(a), float(b), n
+    return lo, hi, 2
+
+
 def _clim(name: str, v: np.ndarray | None, clim: Sequence[float] | None) -> tuple[float, float]:
+    """Colour limits: ``clim`` as given, else the data's range widened to round numbers
+    (:func:`nice_limits`; symmetric about 0 for signed arrays such as fold angles)."""
     if clim is not None:
         return float(clim[0]), float(clim[1])
     finite = v[np.isfinite(v)] if v is not None else np.zeros(0)
@@ -210,9 +229,10 @@ def _clim(name: str, v: np.ndarray | None, clim: Sequence[float] | None) -> tupl
     sym = ARRAYS.get(name, ("", "", False))[2]
     if sym:
         m = float(np.abs(finite).max()) or 1.0
-        return (-m, m)
+        lo, hi, _ = nice_limits(-m, m)
+        return (-max(-lo, hi), max(-lo, hi))
     lo, hi = float(finite.min()), float(finite.max())
-    return (lo, hi) if hi > lo else (lo - 1.0, lo + 1.0)
+    return nice_limits(lo, hi)[:2] if hi > lo else (lo - 1.0, lo + 1.0)
 
 
 # ---------------------------------------------------------------------------- pyvista
@@ -270,8 +290,10 @@ def _add_state(p, meshes, where: str, name: str, cmap, clim, line_width: float, 
     label = label or default_label
     cmap = cmap or default_cmap
     fs = max(10, int(round(p.window_size[1] / 45)))
+    lo, hi = clim
+    n_labels = nice_limits(lo, hi, 7 if p.window_size[0] >= 800 else 5)[2]
     sbar = {
-        "n_labels": 5 if p.window_size[0] >= 800 else 3,
+        "n_labels": n_labels,  # on the round numbers of nice_limits when clim is theirs
         "title": label,
         "vertical": False,
         "position_x": 0.25,
@@ -459,6 +481,23 @@ def _render_mpl(d, where, name, values, cmap, clim, path, window_size, view, tit
     return path
 
 
+def _add_supports_and_loads(
+    p, X: np.ndarray, fixed: np.ndarray | None, loads: np.ndarray | None
+) -> None:
+    """Black dots at the supported nodes, purple arrows along the loads."""
+    size = float(np.linalg.norm(np.ptp(X, axis=0))) or 1.0
+    if fixed is not None:
+        f = np.asarray(fixed, bool).reshape(-1, 3)[: len(X)].any(axis=1)
+        if f.any():
+            p.add_points(X[f], color="black", point_size=12, render_points_as_spheres=True)
+    if loads is not None:
+        F = np.asarray(loads, float).reshape(-1, 3)[: len(X)]
+        mag = np.linalg.norm(F, axis=1)
+        on = mag > 0
+        if on.any():
+            p.add_arrows(X[on], F[on], mag=0.08 * size / mag.max(), color="#8e44ad")
+
+
 # ------------------------------------------------------------------------------ API
 def render_state(
     X: np.ndarray,
@@ -475,6 +514,8 @@ def render_state(
     title: str | None = None,
     label: str | None = None,
     backend: str = "auto",
+    fixed: np.ndarray | None = None,
+    loads: np.ndarray | None = None,
 ) -> Path:
     """Render one state to a PNG, coloured by a named array.
 
@@ -498,6 +539,11 @@ def render_state(
     title, label : str, optional
         Title of the picture; title of the colour bar (default: the array's name and unit).
     backend : {"auto", "pyvista", "matplotlib"}
+    fixed : (n_nodes, 3) bool, optional
+        Supports: nodes with a fixed DOF are drawn as black dots (pyvista backend).
+    loads : (n_nodes, 3) float, optional
+        Loads: purple arrows at the loaded nodes, the largest 8 % of the state's size long
+        (pyvista backend).
     """
     path = Path(path)
     d = state_data(
@@ -515,6 +561,7 @@ def render_state(
         meshes = _polydata(d)
         _assign(meshes, d, where, name, values)
         bar = _add_state(p, meshes, where, name, cmap, lim, line_width=2.0, label=label)
+        _add_supports_and_loads(p, d.points, fixed, loads)
         _camera(p, _bounds(d.points[None]), view)
         _fit(p, bottom=0.16 if bar is not None else 0.0, top=0.08 if title else 0.0)
         _scalar_bar(p, bar)
