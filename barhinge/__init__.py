@@ -9,6 +9,7 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
+from barhinge import results as _results
 from barhinge._version import __version__ as __version__
 from barhinge.actuators import Actuators
 from barhinge.errors import BarhingeError, ConfigError, ConvergenceError, PatternError
@@ -34,6 +35,7 @@ _LAZY = {
     "solve": "barhinge.solve.newton",
     "tangent_stiffness": "barhinge.analysis.stiffness",
     "gaussian_curvature": "barhinge.analysis.curvature",
+    "periodic_cell": "barhinge.analysis.periodic",
 }
 
 __all__ = [
@@ -46,6 +48,16 @@ __all__ = [
     "PatternError",
     *_LAZY,
 ]
+
+
+def _html_display(path: FoldPath) -> str:
+    """The viewer of a fold path inside an iframe (Jupyter's rich display of FoldPath)."""
+    from barhinge.view import iframe_html
+
+    return iframe_html(path)
+
+
+_results.HTML_DISPLAY = _html_display
 
 
 def __getattr__(name: str) -> Any:

@@ -2,7 +2,8 @@
 
 The sparsity pattern of the tangent and the map from every element-matrix entry to its
 position in the CSR ``data`` array are built once per model (:class:`Assembler`), at the
-level of 3x3 node-pair blocks (one ``unique`` over node pairs, then arithmetic); each
+level of 3x3 node-pair blocks (one ``unique`` over node pairs, then arithmetic, with 32-bit
+indices wherever the counts allow and the temporaries bounded by one element group); each
 evaluation is then one ``bincount`` scatter of the element values into a fresh data array
 that shares the pattern's ``indices`` and ``indptr``.
 
@@ -47,6 +48,7 @@ class Assembler:
         self._fdofs = (
             np.concatenate([D.T.ravel() for D in self.dofs]) if self.dofs else np.zeros(0, int)
         )
+        n_packed = sum(len(iu) * len(c) for c, (iu, _) in zip(conns, self.triu, strict=True))
 
         # 1. node-pair blocks: every element couples its node pairs (a <= b locally)
         pair_keys, pair_of = [], []
@@ -56,56 +58,96 @@ class Assembler:
             pair_keys.append((np.minimum(A, B) * N + np.maximum(A, B)).T.ravel())
             pair_of.append((la, lb))
         allp = np.concatenate(pair_keys) if pair_keys else np.zeros(0, np.int64)
+        del pair_keys
         ublk, inv = np.unique(allp, return_inverse=True)
-        inv = inv.ravel()
+        del allp
         nblk = len(ublk)
         self.n_upper = 9 * nblk  # a 3x3 slot per node-pair block (upper part on diagonals)
+        # index dtype of every map below: int32 wherever the counts allow (halves the maps)
+        itype = np.int32 if max(n_packed, 2 * self.n_upper, n) < 2**31 - 1 else np.int64
+        inv = inv.ravel().astype(itype)
+        self._fdofs = self._fdofs.astype(itype)
 
-        # 2. slot of every packed element entry (entry-major), then the 0/1 summation matrix
-        slots, off = [], 0
+        # 2. slot of every packed element entry (entry-major), one entry row at a time so
+        #    the temporaries stay the size of one group's element count
+        slot = np.empty(n_packed, itype)
+        off_pair = off_slot = 0
         for c, (la, lb), (iu, ju) in zip(conns, pair_of, self.triu, strict=True):
-            ne, npair = len(c), len(la)
-            blk = inv[off : off + ne * npair].reshape(npair, ne)
-            off += ne * npair
+            ne = len(c)
+            blk = inv[off_pair : off_pair + ne * len(la)].reshape(len(la), ne)
+            off_pair += ne * len(la)
             pidx = {(int(a), int(b)): q for q, (a, b) in enumerate(zip(la, lb, strict=True))}
-            a_loc, b_loc, ra, cb = iu // 3, ju // 3, iu % 3, ju % 3
-            q = np.array([pidx[(int(a), int(b))] for a, b in zip(a_loc, b_loc, strict=True)])
-            swap = (c[:, a_loc] > c[:, b_loc]).T  # (n_entries, ne)
-            comp = np.where(swap, (3 * cb + ra)[:, None], (3 * ra + cb)[:, None])
-            slots.append((blk[q] * 9 + comp).ravel())
-        slot = np.concatenate(slots) if slots else np.zeros(0, np.int64)
-        nv = len(slot)
-        itype = np.int32 if max(nv, self.n_upper, n) < 2**31 - 1 else np.int64
+            for r, s in zip(iu, ju, strict=True):
+                a, b, ra, cb = r // 3, s // 3, r % 3, s % 3
+                swapped = c[:, a] > c[:, b]
+                comp = np.where(swapped, 3 * cb + ra, 3 * ra + cb).astype(itype)
+                np.add(blk[pidx[(int(a), int(b))]] * 9, comp, out=slot[off_slot : off_slot + ne])
+                off_slot += ne
+        del inv
+
+        # the 0/1 summation matrix, built directly in CSR (rows = slots, sorted by a stable
+        # argsort of the slots; no COO intermediate)
+        order = np.argsort(slot, kind="stable").astype(itype)
+        counts = np.bincount(slot, minlength=self.n_upper)
+        del slot
+        indptr_sum = np.zeros(self.n_upper + 1, itype)
+        np.cumsum(counts, out=indptr_sum[1:])
+        del counts
         self._sum = sp.csr_matrix(
-            (np.ones(nv), (slot.astype(itype), np.arange(nv, dtype=itype))),
-            shape=(self.n_upper, nv),
+            (np.ones(n_packed), order, indptr_sum), shape=(self.n_upper, n_packed), copy=False
         )
+        self._sum.has_sorted_indices = False
+        del order
 
         # 3. full symmetric CSR pattern from the blocks, and the gather from the slots
-        bA, bB = ublk // N, ublk % N
+        bA, bB = (ublk // N).astype(itype), (ublk % N).astype(itype)
+        del ublk
         offd = bA != bB
         rn = np.concatenate([bA, bB[offd]])
         cn = np.concatenate([bB, bA[offd]])
-        bid = np.concatenate([np.arange(nblk), np.flatnonzero(offd)])
+        bid = np.concatenate([np.arange(nblk, dtype=itype), np.flatnonzero(offd).astype(itype)])
         tr = np.concatenate([np.zeros(nblk, bool), np.ones(int(offd.sum()), bool)])
-        o = np.argsort(rn * N + cn)
+        del bA, bB, offd
+        o = np.lexsort((cn, rn))
         rn, cn, bid, tr = rn[o], cn[o], bid[o], tr[o]
+        del o
         diag = rn == cn
-        indptr_n = np.concatenate([[0], np.cumsum(np.bincount(rn, minlength=N))])
+        indptr_n = np.zeros(N + 1, itype)
+        np.cumsum(np.bincount(rn, minlength=N), out=indptr_n[1:])
+        del rn
         deg = np.diff(indptr_n)
         seg_len = np.repeat(3 * deg, 3)  # dof row (A, i) holds 3 entries per neighbour
-        seg_start = np.concatenate([[0], np.cumsum(seg_len)])
+        seg_start = np.zeros(n + 1, itype)
+        np.cumsum(seg_len, out=seg_start[1:])
         total = int(seg_start[-1])
-        seg = np.repeat(np.arange(n), seg_len)
-        p = np.arange(total) - seg_start[seg]
-        k = np.repeat(indptr_n[:-1], 3)[seg] + p // 3
-        i, j = seg % 3, p % 3
+        seg = np.repeat(np.arange(n, dtype=itype), seg_len)
+        del seg_len
+        p = np.arange(total, dtype=itype)
+        p -= seg_start[seg]
+        k = np.repeat(indptr_n[:-1], 3)[seg]
+        k += p // 3
+        i = (seg % 3).astype(np.int8)
+        del seg
+        j = (p % 3).astype(np.int8)
+        del p
         lo, hi = np.minimum(i, j), np.maximum(i, j)
         comp = np.where(diag[k], 3 * lo + hi, np.where(tr[k], 3 * j + i, 3 * i + j))
-        self._gather = bid[k] * 9 + comp
-        self.indices = (3 * cn[k] + j).astype(itype)
-        self.indptr = seg_start.astype(itype)
+        del lo, hi, i
+        self._gather = bid[k] * 9
+        self._gather += comp
+        del comp
+        self.indices = 3 * cn[k]
+        self.indices += j
+        self.indptr = seg_start
         self.nnz = total
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes held by the scatter maps and the pattern (bytes; the scratch buffer of
+        :meth:`value_buffers` excluded)."""
+        arrays = [self._fdofs, self._gather, self.indices, self.indptr, *self.dofs]
+        arrays += [self._sum.data, self._sum.indices, self._sum.indptr]
+        return int(sum(a.nbytes for a in arrays))
 
     def __getstate__(self) -> dict:
         state = dict(self.__dict__)

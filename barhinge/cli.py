@@ -246,10 +246,26 @@ def dof(
             f"--png {png}: expected a picture file ending in "
             f"{', '.join(_PICTURE_SUFFIXES[:-1])} or {_PICTURE_SUFFIXES[-1]}"
         )
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
     from barhinge.patterns.spec import read_or_generate
 
     cp = read_or_generate(pattern)
-    rep = compute_dof(cp, triangulated=triangulated, prefer=prefer)
+    bar = Progress(
+        TextColumn("[bold]dof[/] {task.description}"),
+        BarColumn(),
+        TimeElapsedColumn(),
+        console=err_console,
+        disable=as_json,
+        transient=True,
+    )
+    with bar:
+        task = bar.add_task("", total=None)
+
+        def show(stage: str, done: int, total: int) -> None:
+            bar.update(task, description=stage, completed=done, total=total)
+
+        rep = compute_dof(cp, triangulated=triangulated, prefer=prefer, progress=show)
     if png is not None:
         from barhinge.plot.dof import draw_dof
 
@@ -454,6 +470,30 @@ def render(
     else:
         for k, v in written.items():
             console.print(f"[green]{k:>6}[/] {v}", highlight=False)
+
+
+# --- commands: view (interactive HTML) ---
+
+
+@app.command()
+def view(
+    path: Annotated[
+        Path, typer.Argument(help="Result folder, fold_path.npz or FOLD file with frames.")
+    ],
+    output: Annotated[
+        Path | None,
+        typer.Option("--output", "-o", help="HTML file (default: viewer.html beside PATH)."),
+    ] = None,
+) -> None:
+    """Write the fold path as one interactive HTML file that works offline."""
+    from barhinge.output.folder import MANIFEST, add_to_manifest
+    from barhinge.view import write_viewer
+
+    default = path / "viewer.html" if path.is_dir() else path.with_name(f"{path.stem}.html")
+    out = write_viewer(path, output if output is not None else default)
+    if output is None and path.is_dir() and (path / MANIFEST).is_file():
+        add_to_manifest(path, [out])  # a result folder lists the viewer as its own
+    console.print(f"[green]viewer[/] {out}", highlight=False)
 
 
 # --- commands: study (sweeps) ---

@@ -50,3 +50,8 @@ class ConvergenceError(BarhingeError, RuntimeError):
         self.load_factor = load_factor
         self.residuals = list(residuals or [])
         self.last_state = last_state
+
+
+class BucklingError(BarhingeError, RuntimeError):
+    """A linear buckling analysis has no answer (mechanism, nothing in compression, or the
+    eigensolver failed)."""

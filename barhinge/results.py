@@ -11,6 +11,7 @@ import dataclasses
 import json
 import os
 import secrets
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -35,6 +36,11 @@ class Interrupted(KeyboardInterrupt):
     def __init__(self, message: str = "interrupted", *, last_state: Any = None) -> None:
         super().__init__(message)
         self.last_state = last_state
+
+
+#: ``f(fold_path) -> str``: the HTML of a path's rich display in Jupyter; set by
+#: ``barhinge/__init__.py`` to the viewer of :mod:`barhinge.view` (a layer above this one)
+HTML_DISPLAY: Callable[[Any], str] | None = None
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -152,6 +158,10 @@ class FoldPath:
                 v = v[:n_states]
             kw[f.name] = v
         return FoldPath(**kw)
+
+    def _repr_html_(self) -> str | None:
+        """Jupyter's rich display: the interactive viewer (:mod:`barhinge.view`) in an iframe."""
+        return None if HTML_DISPLAY is None else HTML_DISPLAY(self)
 
     # ------------------------------------------------------------------- files
     def save(self, path: str | Path) -> Path:

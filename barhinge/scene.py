@@ -22,6 +22,7 @@ from barhinge import _check
 from barhinge._typing import ControlKind
 from barhinge.actuators import Actuators
 from barhinge.errors import BarhingeError, ConfigError, PatternError
+from barhinge.loads import combine, line_load, pressure_load, projected_load
 from barhinge.solver_options import SolverOptions
 
 __all__ = [
@@ -60,6 +61,9 @@ class Scene:
         (fold angle if actuators, else displacement if prescribed, else load).
     options : SolverOptions or dict, optional
     name : str
+    load_cases : dict str -> (n_nodes, 3) float, optional
+        Named load cases and factored combinations (reference loads); pick one with
+        :meth:`with_load_case`.
     """
 
     model: Any
@@ -71,6 +75,7 @@ class Scene:
     control: str = "auto"
     options: SolverOptions | dict | None = None
     name: str = "scene"
+    load_cases: dict[str, np.ndarray] | None = None
 
     def __post_init__(self) -> None:
         if not hasattr(self.model, "n_nodes") or not hasattr(self.model, "X0"):
@@ -130,6 +135,11 @@ class Scene:
             opts = SolverOptions.from_dict(opts)
         elif not isinstance(opts, SolverOptions):
             raise ConfigError(f"options must be SolverOptions or a dict, got {type(opts).__name__}")
+        cases = {}
+        for cname, arr in (self.load_cases or {}).items():
+            _check.text(cname, "load case name")
+            cases[cname] = _node_array(arr, n, f"load case {cname!r}", float)
+        object.__setattr__(self, "load_cases", cases or None)
         object.__setattr__(self, "supports", S)
         object.__setattr__(self, "loads", L)
         object.__setattr__(self, "prescribed", P)
@@ -160,6 +170,13 @@ class Scene:
             return np.zeros((self.steps + 1, 0))
         start = np.degrees(self.model.hinge_angles(self.model.X0)[self.actuator_hinges()])
         return self.actuators.schedule(self.steps, start_deg=start)
+
+    def with_load_case(self, name: str) -> Scene:
+        """A copy whose reference loads are the load case or combination ``name``."""
+        cases = self.load_cases or {}
+        if name not in cases:
+            raise ConfigError(f"load case {name!r} is unknown; the scene has {sorted(cases)}")
+        return self.with_(loads=cases[name])
 
     def with_(self, **changes: Any) -> Scene:
         """A copy with some fields replaced."""
@@ -280,7 +297,18 @@ def self_weight(model: Any, area_density: float, g: Any = (0.0, 0.0, -9.81)) -> 
 
 
 # ------------------------------------------------------------------------------ TOML
-_TOP_KEYS = {"name", "pattern", "model", "supports", "loads", "prescribed", "actuators", "solve"}
+_TOP_KEYS = {
+    "name",
+    "pattern",
+    "model",
+    "supports",
+    "loads",
+    "load_cases",
+    "combinations",
+    "prescribed",
+    "actuators",
+    "solve",
+}
 #: upper bound of an integer parameter of a pattern family in a scene (cells, stories ...)
 MAX_PATTERN_COUNT = 10_000
 
@@ -337,28 +365,25 @@ def _scene_from_dict(d: dict[str, Any], base_dir: Path) -> Scene:
             key = f"supports.{i}"
             _check_keys(g, _SELECT | {"dofs"}, key)
             supports[np.ix_(_nodes(model, g, key), _dofs(g, key))] = True
-    loads = None
-    if "loads" in d:
-        loads = np.zeros((n, 3))
-        for i, g in enumerate(_groups(d["loads"], "loads")):
-            key = f"loads.{i}"
-            _check_keys(g, _SELECT | {"force", "self_weight"}, key)
-            if "self_weight" in g:
-                sw = g["self_weight"]
-                _check_keys(sw, {"area_density", "g"}, f"{key}.self_weight")
-                if "area_density" not in sw:
-                    raise ConfigError(f"{key}.self_weight needs area_density")
-                rho = _check.number(sw["area_density"], f"{key}.self_weight.area_density", 0.0)
-                g3 = _vec3(sw.get("g", [0.0, 0.0, -9.81]), f"{key}.self_weight.g")
-                loads += self_weight(model, rho, g3)
-            if "force" in g:
-                loads[_nodes(model, g, key)] += _vec3(g["force"], f"{key}.force")
-            elif set(g) & _SELECT:
-                raise ConfigError(f"{key} selects nodes but gives no force = [fx, fy, fz]")
-            elif "self_weight" not in g:
-                raise ConfigError(f"{key} needs force = [fx, fy, fz] or self_weight")
-            if not np.isfinite(loads).all():
-                raise ConfigError(f"{key}: the loads overflow floating point")
+    loads = _loads_from(model, d["loads"], "loads") if "loads" in d else None
+    cases: dict[str, np.ndarray] = {}
+    lc = d.get("load_cases", {})
+    if not isinstance(lc, dict):
+        raise ConfigError(f"load_cases must be a table of named cases, got {_check.show(lc)}")
+    for cname, groups in lc.items():
+        cases[cname] = _loads_from(model, groups, f"load_cases.{cname}")
+    combos = d.get("combinations", {})
+    if not isinstance(combos, dict):
+        raise ConfigError(f"combinations must be a table, got {_check.show(combos)}")
+    for cname, factors in combos.items():
+        if cname in cases:
+            raise ConfigError(f"combinations.{cname} has the name of a load case")
+        if not isinstance(factors, dict):
+            raise ConfigError(
+                f"combinations.{cname} must be a table case = factor, got {_check.show(factors)}"
+            )
+        with _check.prefixed(f"combinations.{cname}: "):
+            cases[cname] = combine(cases, factors)
     prescribed = None
     if "prescribed" in d:
         prescribed = np.full((n, 3), np.nan)
@@ -385,7 +410,14 @@ def _scene_from_dict(d: dict[str, Any], base_dir: Path) -> Scene:
             edges=edges, targets_deg=a.get("targets_deg"), table_deg=a.get("table_deg")
         )
     solve = d.get("solve", {})
-    _check_keys(solve, {"steps", "control", "options"}, "solve")
+    _check_keys(solve, {"steps", "control", "options", "load_case"}, "solve")
+    if "load_case" in solve:
+        lcn = _check.text(solve["load_case"], "solve.load_case")
+        if lcn not in cases:
+            raise ConfigError(f"solve.load_case = {lcn!r}; the scene has {sorted(cases)}")
+        if loads is not None:
+            raise ConfigError("give either [loads] or solve.load_case, not both")
+        loads = cases[lcn]
     steps = _check.integer(solve.get("steps", 50), "solve.steps", 1, MAX_STEPS)
     control = _check.choice(solve.get("control", "auto"), "solve.control", CONTROLS)
     with _check.prefixed("solve.", {"options"}):
@@ -400,7 +432,60 @@ def _scene_from_dict(d: dict[str, Any], base_dir: Path) -> Scene:
         control=control,
         options=options,
         name=name,
+        load_cases=cases or None,
     )
+
+
+def _loads_from(model: Any, groups: Any, where: str) -> np.ndarray:
+    """(n_nodes, 3) reference loads of an array of load groups (forces on selected nodes,
+    self-weight, pressure, projected and line loads)."""
+    n = model.n_nodes
+    loads = np.zeros((n, 3))
+    kinds = {"force", "self_weight", "pressure", "projected", "line_load"}
+    for i, g in enumerate(_groups(groups, where)):
+        key = f"{where}.{i}"
+        _check_keys(g, _SELECT | kinds | {"faces"}, key)
+        if not set(g) & kinds:
+            raise ConfigError(
+                f"{key} needs force = [fx, fy, fz], self_weight, pressure, projected or line_load"
+            )
+        if "self_weight" in g:
+            sw = g["self_weight"]
+            _check_keys(sw, {"area_density", "g"}, f"{key}.self_weight")
+            if "area_density" not in sw:
+                raise ConfigError(f"{key}.self_weight needs area_density")
+            rho = _check.number(sw["area_density"], f"{key}.self_weight.area_density", 0.0)
+            g3 = _vec3(sw.get("g", [0.0, 0.0, -9.81]), f"{key}.self_weight.g")
+            loads += self_weight(model, rho, g3)
+        faces = g.get("faces")
+        if faces is not None and not set(g) & {"pressure", "projected"}:
+            raise ConfigError(f"{key}.faces selects faces for pressure or projected loads only")
+        with _check.prefixed(f"{key}."):
+            if "pressure" in g:
+                loads += pressure_load(model, g["pressure"], faces)
+            if "projected" in g:
+                pr = g["projected"]
+                if isinstance(pr, dict):
+                    _check_keys(pr, {"q", "direction"}, f"{key}.projected")
+                    if "q" not in pr:
+                        raise ConfigError(f"{key}.projected needs q")
+                    loads += projected_load(
+                        model, pr["q"], faces, pr.get("direction", (0.0, 0.0, -1.0))
+                    )
+                else:
+                    loads += projected_load(model, pr, faces)
+        if "line_load" in g:
+            if "edges" not in g or set(g) & (_SELECT - {"edges"}):
+                raise ConfigError(f"{key}.line_load acts on edges = [...] (and nothing else)")
+            with _check.prefixed(f"{key}."):
+                loads += line_load(model, g["line_load"], g["edges"])
+        if "force" in g:
+            loads[_nodes(model, g, key)] += _vec3(g["force"], f"{key}.force")
+        elif set(g) & _SELECT and "line_load" not in g:
+            raise ConfigError(f"{key} selects nodes but gives no force = [fx, fy, fz]")
+        if not np.isfinite(loads).all():
+            raise ConfigError(f"{key}: the loads overflow floating point")
+    return loads
 
 
 CONTROLS: tuple[str, ...] = (*typing.get_args(ControlKind), "auto")

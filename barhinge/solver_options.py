@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import Any
 
 from barhinge import _check
@@ -82,7 +83,18 @@ class SolverOptions:
         Load-factor increment of the first arc-length (MGDCM) step; default ``1/steps``.
     max_arc_steps : int or None
         Cap on arc-length increments (default ``10 * steps``); a run that reaches it before
-        load factor 1 raises :class:`~barhinge.errors.ConvergenceError`.
+        one of its stop criteria raises :class:`~barhinge.errors.ConvergenceError`.
+    arc_stop_load_factor : float or None
+        Arc length stops on this load factor, landing on it exactly. Default: 1 when no other
+        stop criterion is given, else no load-factor stop (the path runs through any load
+        factor until another criterion is met).
+    arc_stop_displacement : mapping or None
+        Arc length stops when one displacement component reaches a value, landing on it
+        exactly: ``{"node": i, "axis": "x" | "y" | "z", "value": u}`` (``u`` in the model's
+        length unit, from the reference position). The node's component must be free.
+    arc_stop_limit_points : int or None
+        Arc length stops at the first state past this many limit points of the load
+        factor (turning points of the load-factor path).
     stability_check : bool or None
         How the inertia of the free-DOF tangent (its number of negative eigenvalues, actuators
         released) is found at every recorded state (``FoldPath.meta["negative_eigenvalues"]``
@@ -118,6 +130,9 @@ class SolverOptions:
     krylov_max: int = 30
     arc_length_increment: float | None = None
     max_arc_steps: int | None = None
+    arc_stop_load_factor: float | None = None
+    arc_stop_displacement: dict[str, Any] | None = None
+    arc_stop_limit_points: int | None = None
     flat_start: str = "rigid"
     stability_check: bool | None = None
 
@@ -160,6 +175,33 @@ class SolverOptions:
             num("arc_length_increment", 0.0)
         if self.max_arc_steps is not None:
             whole("max_arc_steps", 1, MAX_ARC_STEPS)
+        if self.arc_stop_load_factor is not None:
+            num("arc_stop_load_factor", -math.inf)
+        if self.arc_stop_limit_points is not None:
+            whole("arc_stop_limit_points", 1, MAX_ARC_STEPS)
+        if self.arc_stop_displacement is not None:
+            object.__setattr__(
+                self, "arc_stop_displacement", _displacement_stop(self.arc_stop_displacement)
+            )
+
+    def has_arc_stop(self) -> bool:
+        """Whether any arc-length stop criterion other than the default is given."""
+        return any(
+            v is not None
+            for v in (
+                self.arc_stop_load_factor,
+                self.arc_stop_displacement,
+                self.arc_stop_limit_points,
+            )
+        )
+
+    def arc_stop_lambda(self) -> float | None:
+        """The load factor arc length stops on (None: no load-factor stop)."""
+        if self.arc_stop_load_factor is not None:
+            return float(self.arc_stop_load_factor)
+        if self.arc_stop_displacement is None and self.arc_stop_limit_points is None:
+            return 1.0
+        return None
 
     def reuses_factorization(self, control: str) -> bool:
         """Whether the solve under ``control`` reuses factorisations (see the option)."""
@@ -186,3 +228,29 @@ class SolverOptions:
                     f"{', '.join(sorted(names))}"
                 )
         return cls(**d)
+
+
+_AXES = {"x": 0, "y": 1, "z": 2}
+
+
+def _displacement_stop(spec: Any) -> dict[str, Any]:
+    """``{"node": int >= 0, "axis": "x"|"y"|"z", "value": finite float}`` from a mapping."""
+    key = "options.arc_stop_displacement"
+    if not isinstance(spec, dict):
+        raise ConfigError(
+            f"{key} = {_check.show(spec)}; expected a table {{node = i, axis = 'z', value = u}}"
+        )
+    extra = set(spec) - {"node", "axis", "value"}
+    missing = {"node", "axis", "value"} - set(spec)
+    if extra or missing:
+        what = f"unknown key(s) {sorted(extra)}" if extra else f"missing {sorted(missing)}"
+        raise ConfigError(f"{key}: {what}; expected keys node, axis, value")
+    node = _check.integer(spec["node"], f"{key}.node", 0)
+    axis = _check.choice(spec["axis"], f"{key}.axis", tuple(_AXES))
+    value = _check.number(spec["value"], f"{key}.value")
+    return {"node": node, "axis": axis, "value": value}
+
+
+def displacement_stop_dof(spec: dict[str, Any]) -> int:
+    """Global DOF index (xyz interleaved per node) of a validated displacement stop."""
+    return 3 * int(spec["node"]) + _AXES[spec["axis"]]

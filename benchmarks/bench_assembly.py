@@ -9,6 +9,7 @@ Prints a table of median wall and CPU times per call:
 from __future__ import annotations
 
 import argparse
+import resource
 import time
 
 import numpy as np
@@ -41,9 +42,11 @@ def main() -> None:
     t0 = time.perf_counter()
     model = BarHingeModel.from_pattern(cp, scheme=args.scheme)
     t_model = time.perf_counter() - t0
+    rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB on Linux
     t0, c0 = time.perf_counter(), time.process_time()
     asm = model.assembler
     t_asm, c_asm = time.perf_counter() - t0, time.process_time() - c0
+    rss_asm = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - rss0
     X = model.X0 + 1e-3 * np.random.default_rng(0).normal(size=model.X0.shape)
 
     rows = [
@@ -59,6 +62,13 @@ def main() -> None:
     print(
         f"one-off: pattern {t_pattern:.2f} s, model {t_model:.2f} s, "
         f"scatter maps {t_asm:.2f} s (cpu {c_asm:.2f} s)"
+    )
+    k_bytes = asm.nnz * (8 + asm.indices.itemsize)
+    print(
+        f"scatter maps: {asm.nbytes / 1e6:.0f} MB kept, peak process growth while building "
+        f"{rss_asm / 1e3:.0f} MB; one tangent (CSR) {k_bytes / 1e6:.0f} MB "
+        f"(maps kept / tangent {asm.nbytes / k_bytes:.1f}x, peak / tangent "
+        f"{rss_asm * 1e3 / k_bytes:.1f}x)"
     )
     print(f"{'per call (median of ' + str(args.repeat) + ')':<28}{'wall s':>10}{'cpu s':>10}")
     for name, (w, c) in rows:

@@ -50,7 +50,7 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("kinematics", ["barhinge.kinematics", "barhinge.kinematics.*"]),
     ("kernels", ["barhinge.kernels", "barhinge.kernels.*", "barhinge.assembly"]),
     ("model", ["barhinge.model", "barhinge.model.*"]),
-    ("scene", ["barhinge.solver_options", "barhinge.scene"]),
+    ("scene", ["barhinge.solver_options", "barhinge.loads", "barhinge.scene"]),
     ("solve", ["barhinge.solve", "barhinge.solve.*"]),
     ("analysis", ["barhinge.analysis", "barhinge.analysis.*"]),
     # what output/ writes, as data: fields on the mesh (meshio), the step table, the summary,
@@ -62,11 +62,14 @@ LAYERS: list[tuple[str, list[str]]] = [
             "barhinge.output.table",
             "barhinge.output.summary",
             "barhinge.output.folder",
+            "barhinge.modes_vtu",
         ],
     ),
     ("plot", ["barhinge.plot", "barhinge.plot.*"]),
     # the one writer of a run (run.py) and its pictures (pictures.py)
     ("output", ["barhinge.output", "barhinge.output.*"]),
+    # the interactive HTML viewer of a result folder (it reads what output/ wrote)
+    ("view", ["barhinge.view", "barhinge.view.*"]),
     ("apps", ["barhinge.verify", "barhinge.sweep"]),
     ("cli", ["barhinge.cli", "barhinge.__main__"]),
     ("api", ["barhinge"]),

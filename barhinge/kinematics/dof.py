@@ -4,7 +4,8 @@
   structures", Proc. IASS): ``E_in - 3 V_in - sum_panels (n - 3)`` where ``E_in`` counts the
   interior creases of the triangulated pattern and ``V_in`` the interior vertices; each n-gon
   panel adds ``n - 3`` diagonals and ``n - 3`` planarity conditions, so the count equals
-  (creases) - 3 (interior vertices) in the angle formulation.
+  (creases) - 3 (interior vertices) in the angle formulation; each hole subtracts 6 more
+  (the closure of the chain of panels around it, :mod:`barhinge.kinematics.holes`).
 * True (first-order) DOF: ``n_var - rank J`` with ``J`` the loop-closure Jacobian
   (:mod:`barhinge.kinematics.constraints`) at the given state; the number of redundant
   constraints is ``rank deficiency of the rows = DOF - count``. The flat state is special:
@@ -24,7 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -33,15 +34,20 @@ import scipy.sparse as sp
 
 from barhinge.errors import ConfigError, PatternError
 from barhinge.kinematics.constraints import RigidConstraints
+from barhinge.kinematics.holes import hole_loops
 from barhinge.linalg.nullspace import DENSE_LIMIT, NullSpace, RankError, null_space
+from barhinge.linalg.threads import single_threaded_dense
 from barhinge.pattern.crease import CreasePattern
 
-__all__ = ["DofReport", "dof", "select_actuators", "folded_sample"]
+__all__ = ["DofReport", "dof", "select_actuators", "folded_sample", "system", "closure_errors"]
 
 log = logging.getLogger(__name__)
 
 #: a state whose largest |fold angle| is below this (rad) is reported as flat
 FLAT_TOL = 1e-6
+#: up to this many columns a Gauss-Newton step of the folded-state search is a dense
+#: least-squares solve; above, one sparse factorisation of the damped normal matrix
+STEP_DENSE_LIMIT = DENSE_LIMIT
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -53,7 +59,7 @@ class DofReport:
     global_dof : int
         First-order DOF ``n_variables - rank`` at this state.
     counted_dof : int
-        Tachi (2010) count ``E_in - 3 V_in - sum(n - 3)``.
+        Tachi (2010) count ``E_in - 3 V_in - 6 holes - sum(n - 3)``.
     redundant : int
         Redundant constraints ``global_dof - counted_dof`` (= n_equations - rank).
     rank : int
@@ -165,6 +171,7 @@ class DofReport:
 
 
 # ------------------------------------------------------------------------- public API
+@single_threaded_dense
 def dof(
     cp: CreasePattern,
     state: np.ndarray | Sequence[float] | None = None,
@@ -173,6 +180,7 @@ def dof(
     prefer: str | Sequence[int] | None = None,
     tol: float | None = None,
     folded_check: bool = True,
+    progress: Callable[[str, int, int], None] | None = None,
 ) -> DofReport:
     """Global and local degrees of freedom of ``cp`` as a rigid origami.
 
@@ -192,6 +200,10 @@ def dof(
         Relative singular-value threshold for the rank (default 1e-8 dense SVD, 1e-6 sparse).
     folded_check : bool
         At a flat state, also analyse a folded state nearby (``report.folded``).
+    progress : callable, optional
+        Called as ``progress(stage, done, total)`` before each stage of the work (the rank,
+        local DOF, actuators, the folded-state search, ...) and once at the end with
+        ``done == total`` (the CLI draws a progress bar from it).
 
     Returns
     -------
@@ -202,24 +214,48 @@ def dof(
         if s.ndim == 2 and s.shape == (cp.n_vertices, 3):
             cp = cp.replaced(vertices=s, validate=False)
             state = None
+    tick = _Ticker(progress, 4)
+    tick("loop-closure constraints")
     rc = RigidConstraints.from_pattern(cp, triangulated=triangulated)
     rho = _state_angles(rc, state)
-    rep = _report(rc, rho, prefer=prefer, tol=tol)
-    if rc.holes:
+    if folded_check and rc.n_var > 0 and np.max(np.abs(rho), initial=0.0) < FLAT_TOL:
+        tick.total = 8
+    rep = _report(rc, rho, prefer=prefer, tol=tol, tick=tick)
+    hl = hole_loops(rc)
+    if hl.n_holes:
         rep = dataclasses.replace(
             rep,
             note=_join(
                 rep.note,
-                f"the pattern has {rc.holes} hole(s): loops of panels around a hole are not "
+                f"the pattern has {hl.n_holes} hole(s): the chain of panels around each adds "
+                "6 closure conditions",
+            ),
+        )
+    missing = rc.holes - hl.n_holes
+    if missing > 0:
+        rep = dataclasses.replace(
+            rep,
+            note=_join(
+                rep.note,
+                f"{missing} hole(s) whose boundary touches another boundary loop are not "
                 "constrained, so the DOF may be over-estimated",
             ),
         )
     if rep.flat and folded_check and rc.n_var > 0:
+        tick("folded state nearby")
         try:
             rho_f = folded_sample(rc)
         except PatternError as exc:
-            return dataclasses.replace(rep, note=_join(rep.note, str(exc)))
-        folded = _report(rc, rho_f, prefer=prefer, tol=tol)
+            tick.finish()
+            msg = str(exc)
+            n_poly = sum(len(f) > 3 for f in rc.pattern.faces)
+            if n_poly and not rc.triangulated:
+                msg += (
+                    f"; {n_poly} non-triangular panel(s) are held rigid and flat "
+                    "(triangulated=True / --triangulated lets them fold along a diagonal)"
+                )
+            return dataclasses.replace(rep, note=_join(rep.note, msg))
+        folded = _report(rc, rho_f, prefer=prefer, tol=tol, tick=tick)
         wrong = _against_assignment(rc, rho_f)
         if wrong:
             folded = dataclasses.replace(
@@ -239,7 +275,24 @@ def dof(
                 f"at a folded state nearby the DOF is {folded.global_dof}",
             ),
         )
+    tick.finish()
     return rep
+
+
+class _Ticker:
+    """Counts the stages of :func:`dof` for a ``progress(stage, done, total)`` callback."""
+
+    def __init__(self, progress: Callable[[str, int, int], None] | None, total: int) -> None:
+        self.progress, self.total, self.done = progress, total, 0
+
+    def __call__(self, stage: str) -> None:
+        if self.progress is not None:
+            self.progress(stage, self.done, self.total)
+        self.done += 1
+
+    def finish(self) -> None:
+        if self.progress is not None:
+            self.progress("done", self.total, self.total)
 
 
 def _against_assignment(rc: RigidConstraints, rho: np.ndarray) -> int:
@@ -271,17 +324,50 @@ def _state_angles(rc: RigidConstraints, state: Any) -> np.ndarray:
     return rho
 
 
-def _report(rc: RigidConstraints, rho: np.ndarray, *, prefer: Any, tol: float | None) -> DofReport:
+def system(rc: RigidConstraints, rho: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix]:
+    """Residual and Jacobian of all the closure conditions at ``rho`` (n_var,) radians:
+    the vertex loops (3 rows each) followed by the chains around holes (6 rows each)."""
     r, J = rc.evaluate(rho)
+    hl = hole_loops(rc)
+    if hl.n_holes == 0:
+        return r, J
+    rh, Jh = hl.evaluate(rho)
+    return np.concatenate([r, rh]), sp.vstack([J, Jh], format="csr")
+
+
+def closure_errors(rc: RigidConstraints, rho: np.ndarray) -> np.ndarray:
+    """Closure error ``|F - I|`` of every vertex loop followed by that of every hole chain
+    (``|R - I| + |t| / size``)."""
+    return np.concatenate([rc.closure_error(rho), hole_loops(rc).closure_error(rho)])
+
+
+def _report(
+    rc: RigidConstraints,
+    rho: np.ndarray,
+    *,
+    prefer: Any,
+    tol: float | None,
+    tick: Callable[[str], None] = lambda stage: None,
+) -> DofReport:
+    tick(f"rank of the {rc.n_var}-crease Jacobian")
+    r, J = system(rc, rho)
     ns = null_space(J, tol)
     n_faces_extra = 0 if rc.triangulated else sum(len(f) - 3 for f in rc.pattern.faces)
     e_in_tri = rc.n_var + n_faces_extra
-    counted = e_in_tri - 3 * len(rc.vertices) - n_faces_extra
+    n_holes = hole_loops(rc).n_holes
+    counted = e_in_tri - 3 * len(rc.vertices) - 6 * n_holes - n_faces_extra
     g = rc.n_var - ns.rank
-    closure = float(rc.closure_error(rho).max()) if len(rc.vertices) else 0.0
+    closure = float(closure_errors(rc, rho).max(initial=0.0))
     flat = bool(np.max(np.abs(rho), initial=0.0) < FLAT_TOL)
-    local, region = local_dof(rc, rho, tol=tol)
-    acts = select_actuators(rc, ns, prefer=prefer)
+    try:  # a failing library (an SVD or QR that does not converge) is a named error
+        tick("local and region DOF")
+        local, region = local_dof(rc, rho, tol=tol)
+        tick("actuators")
+        acts = select_actuators(rc, ns, prefer=prefer)
+    except (np.linalg.LinAlgError, MemoryError) as exc:
+        raise RankError(
+            f"local DOF or actuator choice failed: {type(exc).__name__}: {exc}"
+        ) from exc
     note = ""
     if closure > 1e-8:
         note = (
@@ -310,7 +396,7 @@ def _report(rc: RigidConstraints, rho: np.ndarray, *, prefer: Any, tol: float | 
         sigma_gap=ns.sigma_gap,
         method=ns.method,
         n_variables=rc.n_var,
-        n_equations=rc.n_eq,
+        n_equations=J.shape[0],
         n_interior_vertices=len(rc.vertices),
         flat=flat,
         local=local,
@@ -363,34 +449,73 @@ def local_dof(
     s = np.linalg.svd(B, compute_uv=False)  # (nv, min(3, D))
     rank_v = (s > rel * np.maximum(s.max(1, keepdims=True), 1e-300)).sum(1)
     local[rc.vertices] = deg - rank_v
-    # regions: vertex + neighbours sharing a crease
-    owner = -np.ones(rc.n_var * 2, dtype=np.int64).reshape(rc.n_var, 2)
-    cnt = np.zeros(rc.n_var, dtype=np.int64)
-    for i, lv in enumerate(rc.loop_var):
-        for k in lv[lv >= 0]:
-            owner[k, cnt[k]] = i
-            cnt[k] += 1
-    members = []
-    for i, lv in enumerate(rc.loop_var):
-        nb = owner[lv[lv >= 0]].ravel()
-        members.append(np.unique(np.concatenate([[i], nb[nb >= 0]])))
-    rmax = max(len(m) for m in members)
-    D = rc.loop_var.shape[1]
-    cmax = rmax * D
-    M = np.zeros((nv, 3 * rmax, cmax))
-    nvar = np.zeros(nv, dtype=np.int64)
-    for i, mem in enumerate(members):
-        vars_ = np.unique(rc.loop_var[mem][rc.loop_var[mem] >= 0])
-        pos = {int(k): c for c, k in enumerate(vars_)}
-        nvar[i] = len(vars_)
-        for r, w in enumerate(mem):
-            lv = rc.loop_var[w]
-            for d in np.flatnonzero(lv >= 0):
-                M[i, 3 * r : 3 * r + 3, pos[int(lv[d])]] = B[w, :, d]
-    s = np.linalg.svd(M, compute_uv=False)
-    rank_r = (s > rel * np.maximum(s.max(1, keepdims=True), 1e-300)).sum(1)
-    region[rc.vertices] = nvar - rank_r
+    region[rc.vertices] = _region_dof(rc.loop_var, B, rel)
     return local, region
+
+
+def _region_members(loop_var: np.ndarray) -> np.ndarray:
+    """(n_cv, R) int: each constrained vertex followed by the constrained vertices that share
+    a crease with it (-1 padding); a crease variable lies in at most two vertex loops."""
+    nv, D = loop_var.shape
+    ok = loop_var >= 0
+    owner = np.broadcast_to(np.arange(nv)[:, None], (nv, D))[ok]
+    var = loop_var[ok]
+    order = np.argsort(var, kind="stable")
+    var, owner = var[order], owner[order]
+    same = np.flatnonzero(var[1:] == var[:-1])  # the two loops of a shared crease
+    a, b = owner[same], owner[same + 1]
+    src = np.concatenate([a, b])
+    dst = np.concatenate([b, a])
+    pairs = np.unique(np.column_stack([src, dst]), axis=0)  # sorted by src
+    cnt = np.bincount(pairs[:, 0], minlength=nv)
+    R = 1 + int(cnt.max(initial=0))
+    members = -np.ones((nv, R), dtype=np.int64)
+    members[:, 0] = np.arange(nv)
+    start = np.concatenate([[0], np.cumsum(cnt)[:-1]])
+    slot = 1 + np.arange(len(pairs)) - start[pairs[:, 0]]
+    members[pairs[:, 0], slot] = pairs[:, 1]
+    return members
+
+
+def _region_dof(
+    loop_var: np.ndarray, B: np.ndarray, rel: float, chunk_bytes: float = 64e6
+) -> np.ndarray:
+    """(n_cv,) DOF of each one-ring region: ``(creases of the region) - rank`` of its stacked
+    vertex blocks ``B`` (n_cv, 3, D), all regions at once (batched SVD, in chunks that keep
+    the stacked matrices below ``chunk_bytes``)."""
+    nv, D = loop_var.shape
+    members = _region_members(loop_var)
+    R = members.shape[1]
+    # variables of every (region, member, slot); -1 where the member or slot is padding
+    V = np.where(members[:, :, None] >= 0, loop_var[np.maximum(members, 0)], -1)  # (nv, R, D)
+    flat = V.reshape(nv, R * D)
+    big = np.iinfo(np.int64).max
+    key = np.where(flat >= 0, flat, big)
+    order = np.argsort(key, axis=1, kind="stable")
+    srt = np.take_along_axis(key, order, axis=1)
+    new = np.ones_like(srt, dtype=bool)
+    new[:, 1:] = srt[:, 1:] != srt[:, :-1]
+    pos_sorted = np.cumsum(new, axis=1) - 1
+    pos = np.empty_like(pos_sorted)
+    np.put_along_axis(pos, order, pos_sorted, axis=1)  # column of each entry in its region
+    nvar = np.sum(new & (srt != big), axis=1)
+    C = int(nvar.max(initial=0))
+    out = np.zeros(nv, dtype=np.int64)
+    per = max(1, int(chunk_bytes // (8 * 3 * R * max(C, 1))))
+    rows3 = np.arange(3)
+    for lo in range(0, nv, per):  # a few chunks, not a loop over vertices
+        hi = min(nv, lo + per)
+        n = hi - lo
+        M = np.zeros((n, R, 3, C))
+        Vc = V[lo:hi]
+        i, r, d = np.nonzero(Vc >= 0)
+        p = pos[lo:hi].reshape(n, R, D)[i, r, d]
+        w = members[lo:hi][i, r]
+        M[i[:, None], r[:, None], rows3[None, :], p[:, None]] = B[w, :, d]
+        s = np.linalg.svd(M.reshape(n, 3 * R, C), compute_uv=False)
+        smax = np.maximum(s.max(1, initial=0.0), 1e-300)
+        out[lo:hi] = nvar[lo:hi] - (s > rel * smax[:, None]).sum(1)
+    return out
 
 
 # ------------------------------------------------------------------------- actuators
@@ -514,43 +639,84 @@ def folded_sample(
 ) -> np.ndarray:
     """A rigidly folded state near the flat one.
 
-    The branch direction (target angles, else M/V signs) is scaled to ``magnitude`` rad; the
+    The branch direction (target angles, else M/V signs; unassigned ``U`` and ``F`` creases
+    have no sign and start at 0, free to fold either way) is scaled to ``magnitude`` rad; the
     crease with the largest component is held there and the others are projected onto the
     constraints by minimum-norm Gauss-Newton (holding one crease keeps the projection from
-    collapsing onto the flat apex of the configuration cone). Raises PatternError if no
-    folded state is found (e.g. a pattern that is not rigidly foldable).
+    collapsing onto the flat apex of the configuration cone). When full steps from that guess
+    do not close, the hold is raised in steps (magnitude / 8, / 4, / 2, 1, each predicted
+    from the last) and a step is halved until the closure error ``sum |F - I|²`` falls: the
+    residual ``vee(skew F)`` also vanishes at loops turned by 180°, which an unguarded step
+    can land on. Raises PatternError if no folded state is found (e.g. a pattern that is not
+    rigidly foldable).
     """
     d = _branch_direction(rc)
     if not np.any(d):
         raise PatternError("no folded state: the pattern has no assignment or target angles")
-    rho0 = magnitude * d / np.max(np.abs(d))
+    d = d / np.max(np.abs(d))
     hold = int(np.argmax(np.abs(d)))
     free = np.ones(rc.n_var, bool)
     free[hold] = False
-    err = np.inf
     backend = None
-    if rc.n_var > DENSE_LIMIT:
+    if rc.n_var > STEP_DENSE_LIMIT:
         from barhinge.linalg.backends import get_backend
 
         backend = get_backend("auto")
-    for fix in (True, False):
-        rho = rho0.copy()
-        cols = np.flatnonzero(free) if fix else np.arange(rc.n_var)
+
+    def merit(x: np.ndarray) -> float:
+        return float(np.sum(closure_errors(rc, x) ** 2))
+
+    def project(rho: np.ndarray, cols: np.ndarray, guarded: bool) -> np.ndarray:
+        m = merit(rho)
+        slow = 0
         for _ in range(max_iter):
-            r, J = rc.evaluate(rho)
-            if np.max(np.abs(r), initial=0.0) < 1e-13:
+            r, J = system(rc, rho)
+            if np.max(np.abs(r), initial=0.0) < 1e-13 and m < 1e-20:
                 break
-            rho[cols] += _min_norm_step(J[:, cols], -r, backend)
-        err = float(rc.closure_error(rho).max()) if len(rc.vertices) else 0.0
-        if err <= 1e-9 and np.max(np.abs(rho)) >= 1e-3 * magnitude:
-            return rho
-    if err > 1e-9:
+            step = np.zeros(rc.n_var)
+            step[cols] = _min_norm_step(J[:, cols], -r, backend)
+            lam = 1.0
+            if guarded and m > 1e-8:  # near a solution full steps converge quadratically
+                while lam > 1e-4 and merit(rho + lam * step) >= m:
+                    lam *= 0.5
+                if lam <= 1e-4:
+                    break  # no descent: a local minimum of the closure error
+            rho = rho + lam * step
+            m_old, m = m, merit(rho)
+            # stalled (5 steps in a row gaining < 1 %: a local minimum or a singular point)
+            slow = slow + 1 if m > 0.99 * m_old else 0
+            if slow >= 5:
+                break
+        return rho
+
+    best = (np.inf, None)
+    collapsed = False
+    for guarded in (False, True):
+        for fix in (True, False):
+            cols = np.flatnonzero(free) if fix else np.arange(rc.n_var)
+            ts = magnitude * (np.array([0.125, 0.25, 0.5, 1.0]) if guarded else np.ones(1))
+            rho = np.zeros(rc.n_var)
+            t_prev = 0.0
+            for t in ts:
+                # predictor: the last state scaled (a cone through the flat state), else d
+                rho = rho * (t / t_prev) if t_prev > 0 else t * d
+                rho[hold] = t * d[hold]
+                t_prev = t
+                rho = project(rho, cols, guarded)
+            err = float(closure_errors(rc, rho).max(initial=0.0))
+            if err <= 1e-9:
+                if np.max(np.abs(rho)) >= 1e-3 * magnitude:
+                    return rho
+                collapsed = True
+            elif err < best[0]:
+                best = (err, rho)
+    if collapsed:
         raise PatternError(
-            f"no rigidly folded state found near the flat one (closure error {err:.1e})"
+            "the projection of the M/V direction onto the constraints collapses to the flat "
+            "state: the pattern is not rigidly foldable (with rigid panels)"
         )
     raise PatternError(
-        "the projection of the M/V direction onto the constraints collapses to the flat "
-        "state: the pattern is not rigidly foldable (with rigid panels)"
+        f"no rigidly folded state found near the flat one (closure error {best[0]:.1e})"
     )
 
 
@@ -560,7 +726,7 @@ def _min_norm_step(J: sp.csr_matrix, b: np.ndarray, backend: Any = None) -> np.n
     damping keeps ``x`` out of the null space of a rank-deficient ``J``; a Krylov
     least-squares solver needed 10⁴–10⁵ iterations on real patterns)."""
     m, n = J.shape
-    if n <= DENSE_LIMIT:
+    if n <= STEP_DENSE_LIMIT:
         return sla.lstsq(J.toarray(), b, cond=1e-9, lapack_driver="gelsd")[0]
     from barhinge.linalg.backends import get_backend
 

@@ -49,10 +49,11 @@ from barhinge.kinematics.constraints import RigidConstraints
 from barhinge.kinematics.dof import FLAT_TOL, _branch_direction
 from barhinge.linalg.backends import SingularMatrixError, get_backend
 from barhinge.linalg.nullspace import DENSE_TOL, null_space
+from barhinge.linalg.threads import single_threaded_dense
 from barhinge.pattern.crease import CreasePattern
 from barhinge.results import FoldPath
 
-__all__ = ["RigidOptions", "rigid_fold", "RigidSolver"]
+__all__ = ["RigidOptions", "RigidSolver", "actuator_conflict", "rigid_fold"]
 
 log = logging.getLogger(__name__)
 
@@ -546,7 +547,6 @@ class RigidSolver:
             lam = lam_new
         return rho, False
 
-
     def _escape_saddle(self, rho: np.ndarray, lam: np.ndarray, e0: float) -> np.ndarray | None:
         """A lower-energy state near the stationary state ``rho`` (multipliers ``lam``) along
         the most negative curvature of the Lagrangian on the tangent space of the free
@@ -637,6 +637,7 @@ def _as_actuators(actuators: Actuators | Sequence[int], targets_deg) -> Actuator
     return Actuators(edges=list(actuators), targets_deg=targets_deg)
 
 
+@single_threaded_dense
 def rigid_fold(
     cp: CreasePattern,
     actuators: Actuators | Sequence[int],
@@ -1038,6 +1039,40 @@ def _dependent_actuators(
     return (
         f"the motion has {ns.basis.shape[1]} DOF and the actuators fix {r}: "
         f"edges {dep} follow from edges {ind} (drive fewer creases or make their targets agree)"
+    )
+
+
+def actuator_conflict(
+    cp: CreasePattern, actuators: Actuators, steps: int, misfit_tol: float = 1e-6
+) -> str | None:
+    """Do the actuators conflict at the state of ``cp`` (its geometry, folded)? The rank test
+    of the rigid-folding constraints with the actuators added, on the first increment
+    ``dt`` of the schedule over ``steps`` steps (from the current angles): compatible when
+    ``J_F d_F = -J_A dt`` has a solution (free creases ``F``, actuators ``A``; linearised at
+    the state). Returns None when it has (or when ``cp`` is flat, where the constraints are
+    singular and the rigid fold off the flat state decides), else a one-line reason naming
+    the dependent actuators (:func:`_dependent_actuators`) and the relative misfit.
+    """
+    rc = RigidConstraints.from_pattern(cp)
+    edges = np.asarray(actuators.edges, dtype=np.int64)
+    av = rc.var_of_source_edge[edges]
+    rho = rc.rho0
+    if np.any(av < 0) or len(av) < 2 or np.max(np.abs(rho), initial=0.0) < FLAT_TOL:
+        return None
+    sched = np.radians(actuators.schedule(steps, start_deg=rc.angles_of_edges(rho)[edges]))
+    dt = sched[1] - sched[0]
+    if not np.any(dt != 0.0):
+        return None
+    solver = RigidSolver(rc, av, RigidOptions())
+    try:
+        _, misfit = solver.tangent(rho, dt)
+    except _Singular:
+        misfit = np.inf
+    if misfit <= misfit_tol:
+        return None
+    return (
+        f"the actuator targets conflict at the start state (rigid folding with the actuators "
+        f"added: linearised misfit {misfit:.1e}); {_dependent_actuators(rc, rho, av, edges)}"
     )
 
 

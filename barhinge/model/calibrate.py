@@ -13,8 +13,10 @@ Sources
   (which we recover as the special case of the general fit below); bending hinges
   ``k_B = C_B D (D_L / t)^(1/3)`` with ``D = E t^3 / (12 (1 - nu^2))``, ``D_L`` the panel
   diagonal and ``C_B = 0.55``; fold hinges ``k_F = L_F D / L*`` with ``L*`` a crease length
-  scale. (The bending formula and C_B are as recalled from F17, which could not be re-read
-  during this work; the bar areas are re-derived and tested in closed form.)
+  scale. (C_B = 0.55 is not confirmed by a readable source; a MERLIN-family code by an F17
+  author puts 1.0 D (D_L/t)^(1/3) on each whole diagonal and 0.55 only in a fold-stiffness
+  cap: docs/calibration.md, finding 5. The ``"plate"`` rule is the one checked against a
+  plate model; the bar areas are re-derived and tested in closed form.)
 * Energy matching: a bar of area ``A`` and length ``L`` under a homogeneous in-plane strain
   stores ``E A L (n.eps.n)^2 / 2``. For each face the bar areas are chosen so that the bars'
   3x3 (Mandel) stiffness ``sum_b A_b L_b m_b m_b^T``, ``m = (n1^2, n2^2, sqrt2 n1 n2)``,

@@ -25,7 +25,14 @@ from barhinge.analysis.curvature import angle_defect, mixed_voronoi_area, patter
 from barhinge.errors import ConfigError
 from barhinge.results import FoldPath
 
-__all__ = ["StateData", "state_data", "state_mesh", "write_state_vtu", "write_xdmf"]
+__all__ = [
+    "StateData",
+    "read_state_vtu",
+    "state_data",
+    "state_mesh",
+    "write_state_vtu",
+    "write_xdmf",
+]
 
 
 class StateData:
@@ -221,6 +228,26 @@ def write_state_vtu(path: str | Path, X: np.ndarray, **kwargs: Any) -> Path:
     path = Path(path)
     state_mesh(X, **kwargs).write(path)
     return path
+
+
+def read_state_vtu(path: str | Path) -> StateData:
+    """Read a ``.vtu`` file written by :func:`write_state_vtu` back into a :class:`StateData`."""
+    import meshio
+
+    try:
+        m = meshio.read(Path(path))
+        blocks = [c.type for c in m.cells]
+        t, li = blocks.index("triangle"), blocks.index("line")
+        return StateData(
+            points=np.asarray(m.points, float),
+            triangles=np.asarray(m.cells[t].data, np.int64),
+            lines=np.asarray(m.cells[li].data, np.int64),
+            point_data={k: np.asarray(v, float) for k, v in m.point_data.items()},
+            triangle_data={k: np.asarray(v[t], float) for k, v in m.cell_data.items()},
+            line_data={k: np.asarray(v[li], float) for k, v in m.cell_data.items()},
+        )
+    except (OSError, ValueError, KeyError, IndexError) as exc:
+        raise ConfigError(f"{path} is not a state written by barhinge ({exc})") from None
 
 
 @contextlib.contextmanager

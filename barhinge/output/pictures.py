@@ -18,12 +18,17 @@ def write_pictures(
     name: str = "result",
     gif: bool = True,
     extra_arrays: tuple[str, ...] = ("energy_density",),
+    fixed: Any | None = None,
+    loads: Any | None = None,
 ) -> dict[str, Path]:
     """Write the standard pictures of a fold path into ``out_dir``.
 
     ``<name>.png`` (final state, creases coloured by fold angle), ``<name>_<array>.png`` for
     each of ``extra_arrays`` (bar-and-hinge paths only), ``<name>_charts.png`` (actuator
     angles, energy split, actuator moments) and ``<name>.gif`` (the fold path).
+
+    ``fixed`` and ``loads`` ((n_nodes, 3) arrays of the scene) are drawn on the state
+    pictures: supports as black dots, loads as purple arrows.
 
     Returns a dict from a picture kind to its path.
     """
@@ -35,14 +40,19 @@ def write_pictures(
     kw: dict[str, Any] = {"model": model, "pattern": cp if model is None else None}
     fa = fold_path.fold_angles_deg[-1] if model is None else None
     done: dict[str, Path] = {}
+    last = fold_path.n_states - 1
+    scene = fold_path.meta.get("scene") or name
+    title = f"{scene}: state {last} of {last}" + ("" if fold_path.converged else " (stopped)")
+    marks: dict[str, Any] = {"fixed": fixed, "loads": loads}
     done["png"] = render.render_state(
-        fold_path.X[-1], out / f"{name}.png", fold_angles_deg=fa, **kw
+        fold_path.X[-1], out / f"{name}.png", fold_angles_deg=fa, title=title, **marks, **kw
     )
     if model is not None:
         for arr in extra_arrays:
             done[arr] = render.render_state(
-                fold_path.X[-1], out / f"{name}_{arr}.png", scalars=arr, **kw
-            )
+                fold_path.X[-1], out / f"{name}_{arr}.png", scalars=arr, title=title,
+                **marks, **kw,
+            )  # fmt: skip
     done["charts"] = out / f"{name}_charts.png"
     charts.summary_figure(fold_path, done["charts"])
     if gif and fold_path.n_states > 1:

@@ -102,13 +102,15 @@ def _write(
     written["json"].write_text(json.dumps(summary, indent=2) + "\n")
     written["csv"] = write_step_table(out / STEPS, step_table(fold_path, model=model, pattern=cp))
     try:
-        written.update(_extras(fold_path, model, cp, out, name, vtu, fields, pictures))
+        marks = {"fixed": fixed, "loads": loads}
+        written.update(_extras(fold_path, model, cp, out, name, vtu, fields, pictures, marks))
     except Exception as exc:  # noqa: BLE001 - an optional extra must not lose the solved path
         log.warning("fields and pictures not all written: %s", exc)
     return written, summary
 
 
-def _extras(fold_path, model, cp, out: Path, name: str, vtu: str, fields: bool, pictures: bool):
+def _extras(fold_path, model, cp, out: Path, name: str, vtu: str, fields: bool, pictures: bool,
+            marks: dict[str, Any]):  # fmt: skip
     """FOLD frames, then (``fields``) XDMF and VTU files, then (``pictures``) pictures."""
     from barhinge.pattern.fold import write_fold_path
 
@@ -130,7 +132,7 @@ def _extras(fold_path, model, cp, out: Path, name: str, vtu: str, fields: bool, 
         from barhinge.output.pictures import write_pictures
 
         try:
-            written.update(write_pictures(fold_path, model, out, pattern=cp, name=name))
+            written.update(write_pictures(fold_path, model, out, pattern=cp, name=name, **marks))
         except Exception as exc:  # noqa: BLE001 - pictures are optional; never lose results
             log.warning("pictures not written: %s", exc)
     return written

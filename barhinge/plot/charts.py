@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 __all__ = [
+    "control_axis",
     "plot_actuator_angles",
     "plot_actuator_moments",
     "plot_energy",
@@ -26,6 +27,40 @@ __all__ = [
 #: more actuators than this: no per-actuator legend
 MAX_LEGEND = 4
 COLORS = ("#1f5fa6", "#c0392b", "#2e8b57", "#8e44ad", "#d68910", "#566573")
+
+
+def control_axis(fold_path: Any) -> tuple[np.ndarray, str]:
+    """(n_states,) x values and label of the charts: what drives the path.
+
+    The actuators' common fold-angle magnitude when actuators drive the path alike (else
+    the first actuator's fold angle); the load factor under load, displacement or arc-length
+    control; else the step.
+    """
+    steps = np.arange(fold_path.n_states, dtype=float)
+    control = fold_path.meta.get("control")
+    act = np.asarray(fold_path.actuator_edges)
+    if len(act) and control in (None, "fold_angle"):
+        A = np.asarray(fold_path.fold_angles_deg[:, act], float)
+        if np.ptp(A[:, 0]) > 0:
+            mag = np.abs(A)
+            if np.allclose(mag, mag[:, :1], rtol=1e-6, atol=1e-6):
+                return mag[:, 0], ("actuators'" if len(act) > 1 else "actuator") + (
+                    " |fold angle| (deg)"
+                )
+            return A[:, 0], f"fold angle of actuator {act[0]} (deg)"
+    lf = np.asarray(fold_path.load_factor, float)
+    if control in ("load", "arc_length", "displacement") and np.ptp(lf) > 0:
+        return lf, "load factor" if control != "displacement" else "displacement factor"
+    return steps, "step"
+
+
+def _actuator_label(fold_path: Any, k: int) -> str | None:
+    """Legend label of the k-th actuator's line: one per actuator up to MAX_LEGEND, else one
+    label for them all."""
+    act = fold_path.actuator_edges
+    if len(act) <= MAX_LEGEND:
+        return f"crease {act[k]}"
+    return f"{len(act)} actuators (creases {min(act)}-{max(act)})" if k == 0 else None
 
 
 def _plt():
@@ -61,13 +96,14 @@ def plot_actuator_angles(fold_path: Any, ax=None, path: str | Path | None = None
     steps = np.arange(fold_path.n_states)
     for a, e in enumerate(fold_path.actuator_edges):
         c = COLORS[a % len(COLORS)]
-        ax.plot(steps, fold_path.fold_angles_deg[:, e], color=c, lw=2, label=f"crease {e}")
+        ax.plot(steps, fold_path.fold_angles_deg[:, e], color=c, lw=2,
+                label=_actuator_label(fold_path, a))  # fmt: skip
         tgt = fold_path.actuator_targets_deg[:, a]
         if np.isfinite(tgt).any():
             ax.plot(steps, tgt, color=c, lw=1, ls="--")
     ax.set_xlabel("step")
     ax.set_ylabel("fold angle (deg, valley > 0)")
-    if 0 < len(fold_path.actuator_edges) <= MAX_LEGEND:
+    if len(fold_path.actuator_edges):
         ax.legend(
             frameon=False,
             fontsize="small",
@@ -78,10 +114,10 @@ def plot_actuator_angles(fold_path: Any, ax=None, path: str | Path | None = None
 
 
 def plot_fold_angles(fold_path: Any, ax=None, path: str | Path | None = None):
-    """Fold angle of every crease vs step (valleys blue, mountains red at the last state;
-    actuators thick black)."""
+    """Fold angle of every crease against the control (:func:`control_axis`); valleys blue,
+    mountains red at the last state, actuators thick black."""
     ax = _axes(ax)
-    steps = np.arange(fold_path.n_states)
+    steps, xlabel = control_axis(fold_path)
     A = np.asarray(fold_path.fold_angles_deg, float)
     moving = np.flatnonzero(np.abs(A).max(0) > 0)
     for e in moving:
@@ -94,7 +130,7 @@ def plot_fold_angles(fold_path: Any, ax=None, path: str | Path | None = None):
         )
         ax.plot(steps, A[:, e], color="black", lw=2.0, label=label)
     ax.axhline(0, color="black", lw=0.6)
-    ax.set_xlabel("step")
+    ax.set_xlabel(xlabel)
     ax.set_ylabel("fold angle (deg; valleys blue, mountains red)")
     if len(fold_path.actuator_edges):
         ax.legend(frameon=False, fontsize="small")
@@ -102,9 +138,10 @@ def plot_fold_angles(fold_path: Any, ax=None, path: str | Path | None = None):
 
 
 def plot_energy(fold_path: Any, ax=None, path: str | Path | None = None):
-    """Stacked energy split (bars, panel bending, folds) vs step."""
+    """Stacked energy split (bars, panel bending, folds) against the control
+    (:func:`control_axis`)."""
     ax = _axes(ax)
-    steps = np.arange(fold_path.n_states)
+    steps, xlabel = control_axis(fold_path)
     parts = [
         ("folds", fold_path.energy_fold, "#1f5fa6"),
         ("panel bending", fold_path.energy_bend, "#2e8b57"),
@@ -113,10 +150,11 @@ def plot_energy(fold_path: Any, ax=None, path: str | Path | None = None):
     ys = [np.nan_to_num(np.asarray(v, float)) for _, v, _ in parts]
     ax.stackplot(steps, *ys, labels=[p[0] for p in parts], colors=[p[2] for p in parts], alpha=0.85)
     ax.plot(steps, np.sum(ys, axis=0), color="black", lw=1.2, label="total")
-    ax.set_xlabel("step")
+    ax.set_xlabel(xlabel)
     ax.set_ylabel("stored energy")
     ax.legend(frameon=False, fontsize="small", loc="upper left")
-    ax.set_xlim(steps[0], max(steps[-1], 1))
+    if np.ptp(steps) > 0:
+        ax.set_xlim(steps.min(), steps.max())
     return _finish(ax, path, "Energy split")
 
 
@@ -131,12 +169,12 @@ def plot_actuator_moments(fold_path: Any, ax=None, path: str | Path | None = Non
             ms=3,
             lw=1.6,
             color=COLORS[a % len(COLORS)],
-            label=f"crease {e}",
+            label=_actuator_label(fold_path, a),
         )
     ax.axhline(0, color="black", lw=0.8)
     ax.set_xlabel("actuator fold angle (deg)")
     ax.set_ylabel("actuator moment (force x length)")
-    if 0 < len(fold_path.actuator_edges) <= MAX_LEGEND:
+    if len(fold_path.actuator_edges):
         ax.legend(frameon=False, fontsize="small")
     return _finish(ax, path, "Actuator moments")
 

@@ -3,16 +3,19 @@
 PyVista (VTK) is imported lazily, only when a picture is made. Off-screen rendering uses EGL
 (``VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow``; Mesa's software renderer is enough). On a
 machine without a GL stack VTK crashes the process instead of raising, so the first render
-probes VTK once in a subprocess (result cached for the session) and, if that fails, falls back
-to a matplotlib 3-D render (``backend="auto"``) or raises :class:`RenderError`
-(``backend="pyvista"``).
+probes VTK in a subprocess (a success is remembered on disk, per machine set-up) and, if that
+fails, falls back to a matplotlib 3-D render (``backend="auto"``) or raises
+:class:`RenderError` (``backend="pyvista"``).
 
 Colours follow the crease-pattern drawings: valley folds (rho > 0) blue, mountain folds red.
 """
 
 from __future__ import annotations
 
+import ctypes.util
 import functools
+import importlib.metadata
+import json
 import logging
 import os
 import subprocess
@@ -71,13 +74,24 @@ def _set_egl_env() -> None:
 
 @functools.cache
 def can_render_offscreen() -> bool:
-    """True if VTK can render off-screen here (probed once in a subprocess, then cached).
+    """True if VTK can render off-screen here.
 
-    Set ``BARHINGE_OFFSCREEN=1`` (or ``0``) to skip the probe (a few seconds per process).
+    Probed in a subprocess (VTK may crash the process it runs in); a success is remembered
+    on disk (``$XDG_CACHE_HOME/barhinge/offscreen.json``, keyed by the Python, the VTK
+    version, the EGL library and the environment variables that choose the GL stack), so a
+    machine is probed once, not on every run. Set ``BARHINGE_OFFSCREEN=1`` (or ``0``) to skip
+    the probe.
     """
     forced = os.environ.get("BARHINGE_OFFSCREEN", "").strip()
     if forced in ("0", "1"):
         return forced == "1"
+    key = _probe_key()
+    cache = _probe_cache_file()
+    try:
+        if json.loads(cache.read_text()).get(key) is True:
+            return True
+    except (OSError, ValueError, AttributeError):
+        pass
     env = {**os.environ, **_EGL}
     env.setdefault("VTK_DEFAULT_OPENGL_WINDOW", _EGL["VTK_DEFAULT_OPENGL_WINDOW"])
     try:
@@ -89,7 +103,55 @@ def can_render_offscreen() -> bool:
         return False
     if r.returncode != 0:
         log.warning("off-screen rendering unavailable (probe exit %d)", r.returncode)
-    return r.returncode == 0
+        return False
+    _remember_probe(cache, key)
+    return True
+
+
+#: environment variables that choose the GL stack VTK renders with
+_GL_ENV = (
+    "DISPLAY",
+    "WAYLAND_DISPLAY",
+    "VTK_DEFAULT_OPENGL_WINDOW",
+    "LIBGL_ALWAYS_SOFTWARE",
+    "EGL_PLATFORM",
+    "MESA_GL_VERSION_OVERRIDE",
+    "PYVISTA_OFF_SCREEN",
+)
+
+
+def _probe_key() -> str:
+    """What a cached probe result depends on: the Python, VTK, the EGL library file and the
+    GL environment."""
+    try:
+        vtk = importlib.metadata.version("vtk")
+    except importlib.metadata.PackageNotFoundError:
+        vtk = "none"
+    egl = ctypes.util.find_library("EGL") or "none"
+    parts = [sys.executable, vtk, egl, *(f"{k}={os.environ.get(k, '')}" for k in _GL_ENV)]
+    return "|".join(parts)
+
+
+def _probe_cache_file() -> Path:
+    root = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(root) / "barhinge" / "offscreen.json"
+
+
+def _remember_probe(cache: Path, key: str) -> None:
+    """Record a successful probe (best effort: an unwritable cache costs one probe per run)."""
+    try:
+        try:
+            known = json.loads(cache.read_text())
+            known = known if isinstance(known, dict) else {}
+        except (OSError, ValueError):
+            known = {}
+        known[key] = True
+        cache.parent.mkdir(parents=True, exist_ok=True)
+        tmp = cache.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_text(json.dumps(known, indent=1))
+        os.replace(tmp, cache)
+    except OSError as exc:
+        log.debug("could not cache the off-screen probe: %s", exc)
 
 
 def _backend(backend: str) -> str:
@@ -139,7 +201,26 @@ def _pick(d: StateData, scalars: str | np.ndarray | None) -> tuple[str, str, np.
     )
 
 
+def nice_limits(lo: float, hi: float, max_ticks: int = 7) -> tuple[float, float, int]:
+    """Limits widened to round numbers and the number of evenly spaced ticks between them,
+    each tick a multiple of a step of 1, 2, 2.5 or 5 times a power of ten (at most
+    ``max_ticks`` ticks)."""
+    if not hi > lo:
+        lo, hi = lo - 1.0, lo + 1.0
+    raw = (hi - lo) / (max_ticks - 1)
+    p = 10.0 ** np.floor(np.log10(raw))
+    for k in (1.0, 2.0, 2.5, 5.0, 10.0, 20.0):
+        step = k * p
+        a, b = np.floor(lo / step + 1e-9) * step, np.ceil(hi / step - 1e-9) * step
+        n = int(round((b - a) / step)) + 1
+        if n <= max_ticks:
+            return float(a), float(b), n
+    return lo, hi, 2
+
+
 def _clim(name: str, v: np.ndarray | None, clim: Sequence[float] | None) -> tuple[float, float]:
+    """Colour limits: ``clim`` as given, else the data's range widened to round numbers
+    (:func:`nice_limits`; symmetric about 0 for signed arrays such as fold angles)."""
     if clim is not None:
         return float(clim[0]), float(clim[1])
     finite = v[np.isfinite(v)] if v is not None else np.zeros(0)
@@ -148,9 +229,10 @@ def _clim(name: str, v: np.ndarray | None, clim: Sequence[float] | None) -> tupl
     sym = ARRAYS.get(name, ("", "", False))[2]
     if sym:
         m = float(np.abs(finite).max()) or 1.0
-        return (-m, m)
+        lo, hi, _ = nice_limits(-m, m)
+        return (-max(-lo, hi), max(-lo, hi))
     lo, hi = float(finite.min()), float(finite.max())
-    return (lo, hi) if hi > lo else (lo - 1.0, lo + 1.0)
+    return nice_limits(lo, hi)[:2] if hi > lo else (lo - 1.0, lo + 1.0)
 
 
 # ---------------------------------------------------------------------------- pyvista
@@ -208,8 +290,10 @@ def _add_state(p, meshes, where: str, name: str, cmap, clim, line_width: float, 
     label = label or default_label
     cmap = cmap or default_cmap
     fs = max(10, int(round(p.window_size[1] / 45)))
+    lo, hi = clim
+    n_labels = nice_limits(lo, hi, 7 if p.window_size[0] >= 800 else 5)[2]
     sbar = {
-        "n_labels": 5 if p.window_size[0] >= 800 else 3,
+        "n_labels": n_labels,  # on the round numbers of nice_limits when clim is theirs
         "title": label,
         "vertical": False,
         "position_x": 0.25,
@@ -397,6 +481,23 @@ def _render_mpl(d, where, name, values, cmap, clim, path, window_size, view, tit
     return path
 
 
+def _add_supports_and_loads(
+    p, X: np.ndarray, fixed: np.ndarray | None, loads: np.ndarray | None
+) -> None:
+    """Black dots at the supported nodes, purple arrows along the loads."""
+    size = float(np.linalg.norm(np.ptp(X, axis=0))) or 1.0
+    if fixed is not None:
+        f = np.asarray(fixed, bool).reshape(-1, 3)[: len(X)].any(axis=1)
+        if f.any():
+            p.add_points(X[f], color="black", point_size=12, render_points_as_spheres=True)
+    if loads is not None:
+        F = np.asarray(loads, float).reshape(-1, 3)[: len(X)]
+        mag = np.linalg.norm(F, axis=1)
+        on = mag > 0
+        if on.any():
+            p.add_arrows(X[on], F[on], mag=0.08 * size / mag.max(), color="#8e44ad")
+
+
 # ------------------------------------------------------------------------------ API
 def render_state(
     X: np.ndarray,
@@ -413,6 +514,8 @@ def render_state(
     title: str | None = None,
     label: str | None = None,
     backend: str = "auto",
+    fixed: np.ndarray | None = None,
+    loads: np.ndarray | None = None,
 ) -> Path:
     """Render one state to a PNG, coloured by a named array.
 
@@ -436,6 +539,11 @@ def render_state(
     title, label : str, optional
         Title of the picture; title of the colour bar (default: the array's name and unit).
     backend : {"auto", "pyvista", "matplotlib"}
+    fixed : (n_nodes, 3) bool, optional
+        Supports: nodes with a fixed DOF are drawn as black dots (pyvista backend).
+    loads : (n_nodes, 3) float, optional
+        Loads: purple arrows at the loaded nodes, the largest 8 % of the state's size long
+        (pyvista backend).
     """
     path = Path(path)
     d = state_data(
@@ -453,6 +561,7 @@ def render_state(
         meshes = _polydata(d)
         _assign(meshes, d, where, name, values)
         bar = _add_state(p, meshes, where, name, cmap, lim, line_width=2.0, label=label)
+        _add_supports_and_loads(p, d.points, fixed, loads)
         _camera(p, _bounds(d.points[None]), view)
         _fit(p, bottom=0.16 if bar is not None else 0.0, top=0.08 if title else 0.0)
         _scalar_bar(p, bar)

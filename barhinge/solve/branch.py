@@ -29,11 +29,12 @@ import numpy as np
 from barhinge._protocols import SolverModel
 from barhinge.actuators import Actuators
 from barhinge.errors import BarhingeError, ConvergenceError
-from barhinge.kinematics.path import RigidOptions, rigid_fold
+from barhinge.kinematics.path import RigidOptions, actuator_conflict, rigid_fold
 from barhinge.model.triangulate import triangulate
 
 __all__ = [
     "RigidGuide",
+    "conflicting_actuators",
     "creases_against_assignment",
     "fold_weights",
     "is_flat",
@@ -224,3 +225,18 @@ def creases_against_assignment(
         want = -want
     f = np.asarray(fold_deg, float)
     return np.flatnonzero(want * f < -min_deg).tolist()
+
+
+def conflicting_actuators(model: Any, actuators: Actuators | None, steps: int) -> str | None:
+    """Before solving a scene that starts folded: do its actuators conflict? The rank of the
+    rigid-folding constraints with the actuators added at the model's reference state
+    (:func:`barhinge.kinematics.path.actuator_conflict`). None when they do not, or for a
+    flat start (the rigid predictor checks those); else a one-line reason naming the
+    dependent actuators (the panels must bend to meet their targets)."""
+    if actuators is None or actuators.n < 2 or is_flat(model):
+        return None
+    try:
+        return actuator_conflict(model.pattern, actuators, steps)
+    except (BarhingeError, RuntimeError, np.linalg.LinAlgError) as exc:
+        log.debug("actuator conflict check skipped: %s", exc)
+        return None

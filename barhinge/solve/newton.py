@@ -21,8 +21,15 @@ import numpy as np
 
 from barhinge.errors import ConfigError, ConvergenceError
 from barhinge.linalg.backends import SingularMatrixError, get_backend
+from barhinge.linalg.threads import threads_for_sparse
 from barhinge.results import FoldPath, Interrupted
-from barhinge.solve.branch import RigidGuide, creases_against_assignment, is_flat, rigid_guide
+from barhinge.solve.branch import (
+    RigidGuide,
+    conflicting_actuators,
+    creases_against_assignment,
+    is_flat,
+    rigid_guide,
+)
 from barhinge.solve.controls import (
     BorderedSystem,
     Timer,
@@ -32,6 +39,7 @@ from barhinge.solve.controls import (
 )
 from barhinge.solve.diagnose import check as check_scene
 from barhinge.solve.diagnose import check_finite_tangent
+from barhinge.solver_options import displacement_stop_dof
 
 if TYPE_CHECKING:
     from barhinge.scene import Scene
@@ -86,6 +94,11 @@ class _Driver:
         if not self.free.any():
             raise ConfigError("every DOF is fixed by supports or prescribed displacements")
         check_scene(scene)  # separate parts, free rigid-body motions, non-finite input
+        if self.opts.has_arc_stop() and scene.control != "arc_length":
+            raise ConfigError(
+                "options.arc_stop_* apply to control = 'arc_length' only; this scene uses "
+                f"control = {scene.control!r}"
+            )
         self.P = scene.loads.ravel()
         pres = scene.prescribed.ravel()
         self.u_pres = np.where(np.isfinite(pres), pres, 0.0)
@@ -127,6 +140,14 @@ class _Driver:
         self._flat_start = bool(self.n_act and self.opts.flat_start == "rigid" and is_flat(model))
         self.flat_start_record: dict[str, Any] | None = None
         self._guide: RigidGuide | None = None
+        # a folded start: conflicting actuators are named before solving (flat starts: by
+        # the rigid predictor)
+        clash = (
+            None if self._flat_start else conflicting_actuators(model, scene.actuators, scene.steps)
+        )
+        self._start_events = [clash] if clash else []
+        for ev in self._start_events:
+            log.warning("%s: %s", scene.name or "solve", ev)
         # stability monitoring: inertia of the free-DOF tangent at every recorded state
         self.exact_inertia = self.opts.exact_inertia(scene.control)
         self._inc_serial = 0  # factorisations made before the current increment
@@ -347,7 +368,7 @@ class _Driver:
         that fold against their M/V assignment."""
         rec = self.flat_start_record
         if not self.records or not (self.n_act and is_flat(self.model)):
-            return []
+            return list(self._start_events)
         rec = rec or {}
         events = list(rec.get("events", []))
         bad = creases_against_assignment(
@@ -771,23 +792,30 @@ class _Driver:
         self.work += h / 6.0 * w
 
     def run_arc_length(self, progress: Progress | None) -> FoldPath:
-        """MGDCM arc length (Leon et al. 2011): states at every increment until the load
-        factor reaches 1; the increment that passes 1 is replaced by a load-control
-        correction onto exactly 1 (from the state before it, else back from the state past
-        it). Raises ConvergenceError when an increment fails after its cut-backs, when the
-        step cap comes first, or when the landing on 1 fails: a path that did not reach
-        load factor 1 is never returned as converged."""
+        """MGDCM arc length (Leon et al. 2011): states at every increment until a stop
+        criterion is met (``options.arc_stop_*``; by default the load factor 1). The
+        increment that passes a load-factor or displacement stop is replaced by a correction
+        onto exactly that value (from the state before it, else back from the state past
+        it); a limit-point stop ends at the first state past the last limit point counted.
+        Raises ConvergenceError when an increment fails after its cut-backs, when the step
+        cap comes first, or when a landing fails: a path that did not reach its stop is
+        never returned as converged."""
         o = self.opts
         steps = self.scene.steps
         max_steps = o.max_arc_steps or 10 * steps
         dl0 = o.arc_length_increment or 1.0 / steps
+        lam_stop = o.arc_stop_lambda()
+        disp = self._displacement_stop()
         st, e = self.initial()
         self.record(st, e, 0, [])
         first_tan: np.ndarray | None = None
         prev_tan: np.ndarray | None = None
         sign = 1.0
         n = 0
-        while st.lam < 1.0 - 1e-12 and n < max_steps:
+        limit_points = 0
+        prev_dlam = 0.0
+        stop: dict[str, Any] | None = None
+        while stop is None and n < max_steps:
             n += 1
             # the tangent at the converged state: its inertia for the record, and the
             # factorisation of this increment's first attempt
@@ -814,8 +842,14 @@ class _Driver:
             if first_tan is None:
                 first_tan = tan
             prev_tan, sign = tan, sgn
-            if new.lam >= 1.0 - 1e-12 and new.lam != 1.0:
-                new, e_new, res = self._land(st, new)
+            dlam = new.lam - st.lam
+            if prev_dlam * dlam < 0.0:
+                limit_points += 1  # the load factor turned between the last two increments
+            prev_dlam = dlam if dlam != 0.0 else prev_dlam
+            new, e_new, res, stop = self._arc_stop(st, new, e_new, res, lam_stop, disp)
+            if stop is None and o.arc_stop_limit_points is not None:
+                if limit_points >= o.arc_stop_limit_points:
+                    stop = {"criterion": "limit_points", "value": limit_points}
             self._arc_s += float(np.linalg.norm(new.x - st.x))
             self._work_simpson(new, e_new, s=self._arc_s)
             st = new
@@ -823,33 +857,151 @@ class _Driver:
             if progress is not None:
                 progress(min(max(int(st.lam * steps), 0), steps), steps, st.lam)
         self.records[-1]["neg"] = self._tangent_inertia(st, e_new if n else e, exact=True)
-        if st.lam != 1.0:
+        if stop is None:
             msg = (
                 f"arc length stopped at its step cap (max_arc_steps = {max_steps}) at load "
-                f"factor {st.lam:.6g} of 1"
+                f"factor {st.lam:.6g} {self._arc_stop_text(lam_stop, disp)}"
             )
             raise ConvergenceError(
                 msg, step=n, load_factor=st.lam, residuals=[],
                 last_state=self.path(converged=False, message=msg),
             )  # fmt: skip
-        return self.path()
+        path = self.path()
+        path.meta["arc_stop"] = stop
+        return path
 
-    def _land(self, st: _State, past: _State) -> tuple[_State, _Eval, list[float]]:
-        """Correct onto load factor exactly 1 by load control: from ``st`` (below 1), else
-        from ``past`` (the arc-length state beyond 1) back. Raises ConvergenceError with the
-        path up to ``st`` when both fail."""
+    def _displacement_stop(self) -> tuple[int, float] | None:
+        """(global DOF, target coordinate) of the displacement stop, checked against the
+        model; None without one."""
+        spec = self.opts.arc_stop_displacement
+        if spec is None:
+            return None
+        if spec["node"] >= self.model.n_nodes:
+            raise ConfigError(
+                f"options.arc_stop_displacement.node = {spec['node']}; the model has "
+                f"{self.model.n_nodes} nodes (0 to {self.model.n_nodes - 1})"
+            )
+        dof = displacement_stop_dof(spec)
+        if not self.free[dof]:
+            raise ConfigError(
+                f"options.arc_stop_displacement: {spec['axis']} of node {spec['node']} is "
+                "fixed by a support or a prescribed displacement; choose a free component"
+            )
+        return dof, float(self.X0.ravel()[dof] + spec["value"])
+
+    def _arc_stop_text(self, lam_stop: float | None, disp: tuple[int, float] | None) -> str:
+        """What the run was asked to reach, for the step-cap message."""
+        if lam_stop is not None and disp is None and self.opts.arc_stop_limit_points is None:
+            return f"of {lam_stop:g}"
+        parts = [f"load factor {lam_stop:g}"] if lam_stop is not None else []
+        if disp is not None:
+            spec = self.opts.arc_stop_displacement
+            parts.append(f"displacement {spec['axis']} = {spec['value']:g} of node {spec['node']}")
+        if self.opts.arc_stop_limit_points is not None:
+            parts.append(f"{self.opts.arc_stop_limit_points} limit point(s)")
+        return "before reaching " + " or ".join(parts)
+
+    def _arc_stop(self, st, new, e_new, res, lam_stop, disp):
+        """Whether the increment ``st`` -> ``new`` passed a load-factor or displacement
+        stop; if so the state landed exactly on it. Returns (state, evaluation, residuals,
+        stop record or None)."""
+
+        def crossed(a: float, b: float) -> bool:
+            return a != 0.0 and (a * b < 0.0 or b == 0.0)
+
+        candidates = []
+        if lam_stop is not None and crossed(st.lam - lam_stop, new.lam - lam_stop):
+            frac = (lam_stop - st.lam) / (new.lam - st.lam)
+            candidates.append((frac, "load_factor"))
+        if disp is not None:
+            dof, target = disp
+            if crossed(st.x[dof] - target, new.x[dof] - target):
+                frac = (target - st.x[dof]) / (new.x[dof] - st.x[dof])
+                candidates.append((frac, "displacement"))
+        if not candidates:
+            return new, e_new, res, None
+        _, which = min(candidates)
+        if which == "load_factor":
+            if new.lam != lam_stop:
+                new, e_new, res = self._land(st, new, lam_stop)
+            return new, e_new, res, {"criterion": "load_factor", "value": lam_stop}
+        dof, target = disp
+        if new.x[dof] != target:
+            new, e_new, res = self._land_displacement(st, new, dof, target)
+        u = target - float(self.X0.ravel()[dof])
+        return new, e_new, res, {"criterion": "displacement", "value": u}
+
+    def _land(
+        self, st: _State, past: _State, lam: float = 1.0
+    ) -> tuple[_State, _Eval, list[float]]:
+        """Correct onto load factor exactly ``lam`` by load control: from ``st`` (before
+        it), else from ``past`` (the arc-length state beyond it) back. Raises
+        ConvergenceError with the path up to ``st`` when both fail."""
         whys = []
         for start in (st, past):
             try:
-                return self.increment(start, start.t, 1.0)
+                return self.increment(start, start.t, lam)
             except _Failed as f:
                 whys.append(f.why)
         msg = (
-            f"arc length passed load factor 1 (from {st.lam:.6g} to {past.lam:.6g}) but the "
-            f"correction onto 1 failed ({whys[0]}; from the far side: {whys[1]})"
+            f"arc length passed load factor {lam:g} (from {st.lam:.6g} to {past.lam:.6g}) "
+            f"but the correction onto {lam:g} failed ({whys[0]}; from the far side: {whys[1]})"
         )
         raise ConvergenceError(
             msg, step=len(self.records), load_factor=st.lam, residuals=[],
+            last_state=self.path(converged=False, message=msg),
+        )  # fmt: skip
+
+    def _land_displacement(
+        self, st: _State, past: _State, dof: int, target: float
+    ) -> tuple[_State, _Eval, list[float]]:
+        """Correct onto coordinate ``target`` of the global DOF ``dof`` (displacement
+        control of that component, the load factor free), starting from the linear
+        interpolation between ``st`` and ``past``. Raises ConvergenceError with the path up
+        to ``st`` when Newton fails."""
+        o = self.opts
+        free = self.free
+        k = int(np.count_nonzero(free[:dof]))  # position of dof among the free DOFs
+        frac = (target - st.x[dof]) / (past.x[dof] - st.x[dof])
+        new = _State(
+            st.x + frac * (past.x - st.x),
+            st.mu + frac * (past.mu - st.mu),
+            st.lam + frac * (past.lam - st.lam),
+            st.t,
+        )
+        new.x[dof] = target
+        zc = np.zeros(self.n_act)
+        res: list[float] = []
+        dx = np.zeros(int(free.sum()))
+        why = f"no convergence in {o.max_iter} iterations"
+        for it in range(1, o.max_iter + 1):
+            e = self.evaluate(new)
+            rf = float(np.linalg.norm(e.r[free]))
+            res.append(rf)
+            self.timer.n_iterations += 1
+            if not np.isfinite(rf):
+                why = "non-finite residual"
+                break
+            if it > 1 and self.converged(e, new, dx, res):
+                return new, e, res
+            try:
+                self.factorize(e, new)
+            except SingularMatrixError as exc:
+                why = f"singular tangent ({exc})"
+                break
+            uh, mh = self.system.solve(self.P[free], zc)
+            ub, mb = self.system.solve(-e.r[free], -e.c)
+            if uh[k] == 0.0:
+                why = "the load does not move the stopping component"
+                break
+            dl = -float(ub[k]) / float(uh[k])
+            dx = dl * uh + ub
+            new.x[free] += dx
+            new.mu = new.mu + dl * mh + mb
+            new.lam += dl
+        msg = f"arc length passed its displacement stop but the correction onto it failed ({why})"
+        raise ConvergenceError(
+            msg, step=len(self.records), load_factor=st.lam, residuals=res,
             last_state=self.path(converged=False, message=msg),
         )  # fmt: skip
 
@@ -902,6 +1054,7 @@ class _Driver:
             it += 1
 
 
+@threads_for_sparse
 def solve(scene: Scene, progress: Progress | None = None) -> FoldPath:
     """Solve a scene along its path; returns a :class:`~barhinge.results.FoldPath`.
 

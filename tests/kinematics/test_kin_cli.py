@@ -77,3 +77,23 @@ def test_dof_command_states_the_gap_and_library_failures_exit_3(monkeypatch):
     with pytest.raises(SystemExit) as exc:
         main(["dof", "miura:nx=2,ny=2", "--json"])
     assert exc.value.code == 3
+
+
+def test_local_dof_library_failure_exits_3(monkeypatch, capsys):
+    """An SVD that does not converge in the local-DOF stage is a RankError (exit 3, one
+    line), not numpy's traceback."""
+    import importlib
+
+    from barhinge.cli import main
+
+    dofm = importlib.import_module("barhinge.kinematics.dof")
+
+    def broken(*a, **k):
+        raise np.linalg.LinAlgError("SVD did not converge")
+
+    monkeypatch.setattr(dofm, "local_dof", broken)
+    with pytest.raises(SystemExit) as exc:
+        main(["dof", "miura:nx=2,ny=2", "--json"])
+    assert exc.value.code == 3
+    err = capsys.readouterr().err
+    assert "SVD did not converge" in err and "Traceback" not in err

@@ -114,3 +114,36 @@ def test_resch_and_waterbomb_fold_from_flat_or_fail_by_name(cp):
             continue
         assert path.converged and path.meta["max_closure"] < 1e-10
         np.testing.assert_allclose(path.fold_angles_deg[-1, a], 0.5 * cp.fold_angles[a], atol=1e-9)
+
+
+def test_underactuated_yoshimura_has_several_strict_energy_minima():
+    """Why an under-actuated Yoshimura sheet has no single rigid limit to converge to: driven
+    from flat by one crease (11 free motions), continuations with 3 and 6 steps end in two
+    different states, each a strict local minimum of the fold-spring energy on the rigid
+    manifold (projected gradient ~0 and positive reduced Hessian of the Lagrangian, both by
+    dense linear algebra independent of the solver), with energies a few percent apart and
+    over a dozen creases folding against their assignment in both (docs/solver.md)."""
+    cp = bh.patterns.yoshimura(4, 3)
+    a = [int(bh.dof(cp).mechanism.actuators[0])]
+    rc = RigidConstraints.from_pattern(cp)
+    E = rc.pattern.edges[rc.crease_edge]
+    w = np.linalg.norm(cp.vertices3d[E[:, 1]] - cp.vertices3d[E[:, 0]], axis=1)
+    free = np.setdiff1d(np.arange(rc.n_var), rc.var_of_source_edge[a])
+    states, energies = [], []
+    for steps in (3, 6):
+        path = bh.rigid_fold(cp, a, targets_deg=0.5 * cp.fold_angles[a], steps=steps)
+        rho = np.radians(path.fold_angles_deg[-1])[rc.var_source_edge]
+        J = rc.jacobian(rho).toarray()[:, free]
+        _, s, Vt = np.linalg.svd(J)
+        Z = Vt[np.sum(s > 1e-8 * s[0]) :].T
+        g = (w * rho)[free]
+        lam = np.linalg.lstsq(J.T, -g, rcond=None)[0]
+        H = np.diag(w[free]) + rc.multiplier_hessian(rho, lam).toarray()[np.ix_(free, free)]
+        assert np.abs(Z.T @ g).max() < 1e-6 * np.abs(g).max()
+        assert np.linalg.eigvalsh(Z.T @ H @ Z).min() > 0.1 * w.min()
+        against = np.sign(cp.fold_angles) * path.fold_angles_deg[-1] < -1e-6
+        assert against.sum() > 10
+        states.append(path.fold_angles_deg[-1])
+        energies.append(0.5 * float(w @ rho**2))
+    assert np.abs(states[0] - states[1]).max() > 0.5  # deg (measured 1.08)
+    assert abs(energies[0] - energies[1]) > 0.01 * min(energies)

@@ -1,0 +1,199 @@
+"""Linear buckling of a bar-and-hinge state: ``(K_E + lambda K_G(dS)) phi = 0``.
+
+The tangent of the model is split by the kernels' own derivatives (exact, no differencing):
+
+* material part ``K_M = sum_bars S'(eps) d d^T + sum_hinges M'(rho) g g^T`` (``d`` the bar
+  strain gradient, ``g`` the fold-angle gradient);
+* geometric part ``K_G(S, M) = sum_bars S B + sum_hinges M d^2 rho / dX^2`` for given bar
+  forces ``S = dW/d eps`` and hinge moments ``M`` (linear in them, at fixed geometry).
+
+Linear buckling at a state ``X`` (default the stress-free reference) under the reference load
+``P``: solve ``K_T(X) du = P`` on the free DOFs, take the stress increments it causes
+(``dS = S' d . du``, ``dM = M' g . du``), and find the smallest positive ``lambda`` with
+``(K_T(X) + lambda K_G(dS, dM)) phi = 0`` (``K_E = K_T(X)``: at the stress-free reference this
+is the material stiffness; at a loaded state the initial stresses stay in it). Solved as
+``-K_G phi = mu K_E phi``, ``lambda = 1 / mu`` for the largest ``mu`` (ARPACK Lanczos,
+``scipy.sparse.linalg.eigsh`` with ``K_E`` factorised: shift-invert at ``lambda = 0``), so
+``lambda P`` is the first bifurcation load of the linearised pre-buckling state (Bazant &
+Cedolin 1991, Stability of Structures, ch. 2; Bathe 2014, Sec. 6.8.2). A limit point of a
+shallow structure is not a bifurcation: check it with arc length.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from barhinge.errors import BucklingError, ConfigError
+from barhinge.kernels.geometry import (
+    bar_strain_derivatives,
+    hinge_angle_gradient,
+    hinge_energy_hessian_packed,
+)
+from barhinge.kernels.laws import bar_linear
+
+__all__ = ["Buckling", "linear_buckling", "stiffness_parts", "geometric_stiffness"]
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Buckling:
+    """Linear buckling factors and modes of a state.
+
+    Attributes
+    ----------
+    factors : (n_modes,) float
+        Load factors ``lambda`` (ascending, > 0): the reference load times ``lambda``
+        buckles the linearised structure.
+    modes : (n_modes, n_nodes, 3) float
+        Mode shapes, scaled to a largest nodal amplitude of 1 (zero at fixed DOFs).
+    X : (n_nodes, 3) float
+        The state.
+    prebuckling : (n_nodes, 3) float
+        Linear displacement under the reference load.
+    """
+
+    factors: np.ndarray
+    modes: np.ndarray
+    X: np.ndarray
+    prebuckling: np.ndarray
+
+
+def _bar_blocks(a: np.ndarray, S: np.ndarray, d: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """(nb, 6, 6) bar matrices ``[[k, -k], [-k, k]]``, ``k = a d d^T + S B``."""
+    k = a[:, None, None] * d[:, :, None] * d[:, None, :] + S[:, None, None] * B
+    return np.block([[k, -k], [-k, k]])
+
+
+def _hinge_packed(model: Any, X: np.ndarray, M: np.ndarray, Kt: np.ndarray) -> np.ndarray:
+    z = np.zeros(len(M))
+
+    def law(rho: np.ndarray, sl: slice):
+        return M[sl], Kt[sl], z[sl]
+
+    *_, Hp = hinge_energy_hessian_packed(X, model.hinges, law)
+    return Hp
+
+
+def geometric_stiffness(
+    model: Any, X: np.ndarray, bar_S: np.ndarray, hinge_M: np.ndarray
+) -> sp.csr_matrix:
+    """(n_dof, n_dof) geometric stiffness at ``X`` of the bar forces ``bar_S = dW/d eps``
+    (n_bars,) and hinge moments ``hinge_M`` (n_hinges,)."""
+    X = np.asarray(X, float).reshape(-1, 3)
+    _, d, B = bar_strain_derivatives(X, model.bars, model.bar_L0, model.strain)
+    nb = len(model.bars)
+    Kb = _bar_blocks(np.zeros(nb), np.asarray(bar_S, float), d, B)
+    asm = model.assembler
+    iu, ju = asm.triu[0]
+    Hp = _hinge_packed(model, X, np.asarray(hinge_M, float), np.zeros(model.n_hinges))
+    return asm.matrix_packed([Kb[:, iu, ju].T, Hp])
+
+
+def stiffness_parts(model: Any, X: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """(material part, geometric part) of the tangent at ``X``; they sum to
+    ``model.tangent(X)``."""
+    X = np.asarray(X, float).reshape(-1, 3)
+    eps, d, B = bar_strain_derivatives(X, model.bars, model.bar_L0, model.strain)
+    S, dS, _ = bar_linear(eps, model.bar_EA, model.bar_L0)
+    rho = model.hinge_angles(X)
+    M, Kt, _ = model._hinge_law(rho)
+    asm = model.assembler
+    iu, ju = asm.triu[0]
+    nb = len(model.bars)
+    Km_b = _bar_blocks(dS, np.zeros(nb), d, B)
+    Km = asm.matrix_packed([Km_b[:, iu, ju].T, _hinge_packed(model, X, np.zeros_like(M), Kt)])
+    Kg = geometric_stiffness(model, X, S, M)
+    return Km, Kg
+
+
+def linear_buckling(
+    model: Any,
+    loads: np.ndarray,
+    fixed: np.ndarray,
+    X: np.ndarray | None = None,
+    n_modes: int = 4,
+) -> Buckling:
+    """Linear buckling factors and modes of the state ``X`` under the reference ``loads``.
+
+    Parameters
+    ----------
+    loads : (n_nodes, 3) float
+        Reference load ``P``.
+    fixed : (n_nodes, 3) bool
+        Supported DOFs.
+    X : (n_nodes, 3) float, optional
+        The state (default ``model.X0``).
+    n_modes : int
+        How many factors to find (fewer are returned if fewer are positive).
+
+    Raises
+    ------
+    BucklingError
+        If the supported stiffness is singular (a mechanism), the load puts nothing in
+        compression, or the eigensolver fails; the message says which.
+    """
+    import scipy.sparse.linalg as spla
+
+    n = model.n_nodes
+    X = np.asarray(model.X0 if X is None else X, float).reshape(n, 3)
+    P = np.asarray(loads, float)
+    F = np.asarray(fixed, bool)
+    if P.shape != (n, 3) or F.shape != (n, 3):
+        raise ConfigError(f"loads and fixed must have shape ({n}, 3), got {P.shape}, {F.shape}")
+    if not isinstance(n_modes, (int, np.integer)) or n_modes < 1:
+        raise ConfigError(f"n_modes = {n_modes!r}; expected an integer >= 1")
+    free = np.flatnonzero(~F.ravel())
+    if len(free) < 2:
+        raise ConfigError("linear buckling needs at least two free DOFs")
+    K = model.tangent(X)
+    Kff = sp.csc_matrix(K[free][:, free])
+    try:
+        lu = spla.splu(Kff)
+    except RuntimeError as exc:
+        raise BucklingError(
+            "linear buckling: the supported stiffness is singular (a mechanism); add supports"
+        ) from exc
+    du = np.zeros(3 * n)
+    du[free] = lu.solve(P.ravel()[free])
+    if not np.all(np.isfinite(du)):
+        raise BucklingError("linear buckling: the pre-buckling solve is not finite (mechanism)")
+    U = du.reshape(n, 3)
+    eps, d, _ = bar_strain_derivatives(X, model.bars, model.bar_L0, model.strain)
+    _, dSde, _ = bar_linear(eps, model.bar_EA, model.bar_L0)
+    dS = dSde * np.einsum("bi,bi->b", d, U[model.bars[:, 1]] - U[model.bars[:, 0]])
+    rho, g = _rho_grad(model, X)
+    _, Kt, _ = model._hinge_law(rho)
+    dM = Kt * np.einsum("hk,hk->h", g, du[_hinge_dofs(model)])
+    Kg = geometric_stiffness(model, X, dS, dM)
+    A = sp.csc_matrix(-Kg[free][:, free])
+    k = min(int(n_modes), len(free) - 1)
+    Kinv = spla.LinearOperator(Kff.shape, matvec=lu.solve, dtype=float)
+    try:
+        mu, vec = spla.eigsh(A, k=k, M=Kff, Minv=Kinv, which="LA", tol=1e-10)
+    except (spla.ArpackNoConvergence, spla.ArpackError, RuntimeError, ValueError) as exc:
+        raise BucklingError(f"linear buckling: the eigensolver failed ({exc})") from exc
+    pos = mu > 1e-12 * max(float(np.abs(mu).max()), 1e-300)
+    if not pos.any():
+        raise BucklingError(
+            "linear buckling: the reference load puts nothing in compression "
+            "(no positive buckling factor)"
+        )
+    mu, vec = mu[pos], vec[:, pos]
+    order = np.argsort(-mu)
+    factors = 1.0 / mu[order]
+    modes = np.zeros((len(order), 3 * n))
+    modes[:, free] = vec[:, order].T
+    modes /= np.abs(modes).max(axis=1, keepdims=True)
+    return Buckling(factors=factors, modes=modes.reshape(-1, n, 3), X=X, prebuckling=U)
+
+
+def _hinge_dofs(model: Any) -> np.ndarray:
+    H = model.hinges
+    return (3 * H[:, :, None] + np.arange(3)).reshape(len(H), 12)
+
+
+def _rho_grad(model: Any, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    return hinge_angle_gradient(X, model.hinges)

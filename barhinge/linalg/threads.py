@@ -1,0 +1,142 @@
+"""Thread policy for the numerical libraries barhinge calls.
+
+Two kinds of work need different threading:
+
+* **small dense calls** (rigid kinematics and the DOF analysis: thousands of SVDs and
+  products of a few hundred entries each): a multithreaded BLAS spends more time waking
+  its threads than computing, and on a busy machine it competes with other processes for
+  the same cores. :func:`dense_calls` runs them with one BLAS thread.
+* **large sparse factorisations** (the bar-and-hinge tangent through MKL PARDISO): threads
+  pay off, but only as many as there are free cores. :func:`sparse_solves` limits MKL to the
+  cores the load average leaves free (at least one).
+
+The policy is set by the environment variable ``BARHINGE_THREADS``:
+
+``auto`` (default)
+    as above;
+``off``
+    barhinge sets no limits (the libraries' own defaults, or ``OMP_NUM_THREADS`` and the
+    like);
+an integer ``n``
+    every library ``n`` threads in both kinds of work.
+
+Limits are applied with threadpoolctl for the duration of one public call and restored
+afterwards.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import os
+from collections.abc import Callable, Iterator
+from typing import Any, TypeVar
+
+from threadpoolctl import ThreadpoolController, threadpool_limits
+
+from barhinge.errors import ConfigError
+
+__all__ = [
+    "dense_calls",
+    "free_cores",
+    "policy",
+    "single_threaded_dense",
+    "sparse_solves",
+    "threads_for_sparse",
+]
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+ENV = "BARHINGE_THREADS"
+
+
+def policy() -> str | int:
+    """``"auto"``, ``"off"`` or a thread count, from ``BARHINGE_THREADS``."""
+    raw = os.environ.get(ENV, "auto").strip().lower() or "auto"
+    if raw in ("auto", "off"):
+        return raw
+    try:
+        n = int(raw)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise ConfigError(f"{ENV} = {raw!r}; expected 'auto', 'off' or a whole number >= 1")
+    return n
+
+
+def cores() -> int:
+    """Cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def free_cores() -> int:
+    """Cores not taken by other work: the usable cores less the one-minute load average
+    (rounded), at least 1."""
+    try:
+        load = os.getloadavg()[0]
+    except (AttributeError, OSError):
+        return cores()
+    return max(1, min(cores(), cores() - round(load) + 1))
+
+
+@contextlib.contextmanager
+def dense_calls() -> Iterator[None]:
+    """One BLAS thread for small dense linear algebra (policy ``auto``), ``n`` for a fixed
+    policy, nothing changed for ``off``."""
+    p = policy()
+    if p == "off":
+        yield
+        return
+    with threadpool_limits(limits=1 if p == "auto" else p, user_api="blas"):
+        yield
+
+
+@contextlib.contextmanager
+def sparse_solves() -> Iterator[None]:
+    """MKL (PARDISO) threads matched to the free cores (policy ``auto``), ``n`` for a fixed
+    policy, nothing changed for ``off``. Dense BLAS keeps one thread under ``auto``: the
+    solver's dense work is small."""
+    p = policy()
+    if p == "off":
+        yield
+        return
+    if p == "auto":
+        # by library: MKL (PARDISO's threads) to the free cores, any other BLAS to one
+        controller = ThreadpoolController()
+        with contextlib.ExitStack() as stack:
+            mkl = controller.select(internal_api="mkl")
+            if mkl.lib_controllers:
+                stack.enter_context(mkl.limit(limits=free_cores()))
+            for api in ("openblas", "blis"):
+                other = controller.select(internal_api=api)
+                if other.lib_controllers:
+                    stack.enter_context(other.limit(limits=1))
+            yield
+        return
+    with threadpool_limits(limits=p):
+        yield
+
+
+def single_threaded_dense(fn: F) -> F:
+    """Decorator: run ``fn`` inside :func:`dense_calls`."""
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        with dense_calls():
+            return fn(*args, **kwargs)
+
+    return wrapper  # type: ignore[return-value]
+
+
+def threads_for_sparse(fn: F) -> F:
+    """Decorator: run ``fn`` inside :func:`sparse_solves`."""
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        with sparse_solves():
+            return fn(*args, **kwargs)
+
+    return wrapper  # type: ignore[return-value]

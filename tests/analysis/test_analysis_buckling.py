@@ -1,0 +1,102 @@
+"""Linear buckling: stiffness split, a strut against its closed form, named errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import barhinge as bh
+from barhinge.analysis.buckling import linear_buckling, stiffness_parts
+from barhinge.errors import BucklingError
+from barhinge.pattern.crease import CreasePattern
+
+
+def _strip(n: int, ell: float = 1.0, b: float = 0.5, k: float = 2.0, rigid: float = 1e7):
+    """A strip of ``n`` panels ``ell x b`` in a row along x, joined by ``n - 1`` transverse
+    creases of rotational stiffness ``k``; panels (bars and bending) ``rigid``."""
+    xs = ell * np.arange(n + 1)
+    V = np.vstack(
+        [np.column_stack([xs, np.zeros(n + 1)]), np.column_stack([xs, np.full(n + 1, b)])]
+    )
+    bot = lambda i: i  # noqa: E731
+    top = lambda i: n + 1 + i  # noqa: E731
+    edges, asg = [], []
+    for i in range(n):
+        edges += [(bot(i), bot(i + 1)), (top(i), top(i + 1))]
+        asg += ["B", "B"]
+    for i in range(n + 1):
+        edges.append((bot(i), top(i)))
+        asg.append("B" if i in (0, n) else "V")
+    faces = [[bot(i), bot(i + 1), top(i + 1), top(i)] for i in range(n)]
+    cp = CreasePattern(V, edges, asg, faces=faces)
+    m = bh.BarHingeModel.from_pattern(
+        cp, "N4B5", bh.Material(E=1.0, nu=0.3, t=0.01), bar_EA=rigid, bend_k=rigid, fold_k=k
+    )
+    S = np.zeros((m.n_nodes, 3), bool)
+    S[[bot(0), top(0)]] = True  # pinned end: the line x = 0 can rotate about y
+    S[[bot(n), top(n)], 1:] = True  # roller end: free to move along x
+    P = np.zeros((m.n_nodes, 3))
+    P[[bot(n), top(n)], 0] = -0.5  # unit axial compression
+    return m, S, P
+
+
+def test_stiffness_parts_sum_to_the_tangent():
+    cp = bh.patterns.miura(2, 2, fold=50.0)
+    m = bh.BarHingeModel.from_pattern(cp, "N5B8", bh.Material(E=1e3, nu=0.3, t=0.01))
+    rng = np.random.default_rng(0)
+    X = m.X0 + 0.01 * rng.standard_normal(m.X0.shape)
+    Km, Kg = stiffness_parts(m, X)
+    K = m.tangent(X)
+    assert abs(Km + Kg - K).max() <= 1e-12 * abs(K).max()
+    # at the stress-free reference the geometric part vanishes
+    Km0, Kg0 = stiffness_parts(m, m.X0)
+    assert abs(Kg0).max() <= 1e-12 * abs(Km0).max()
+
+
+@pytest.mark.parametrize("n", [3, 5, 8])
+def test_strut_of_rigid_links_buckles_at_the_closed_form(n):
+    """Pinned-pinned chain of n rigid links of length l joined by rotational springs k,
+    axial load P: the critical loads are ``P_j = (4 k / l) sin^2(j pi / (2 n))``, j = 1..n-1
+    (the rigid-bar-spring column, e.g. Bazant & Cedolin 1991, Stability of Structures, ch. 1:
+    energy ``k/(2 l^2) sum (w_(i+1) - 2 w_i + w_(i-1))^2 - P/(2 l) sum (w_i - w_(i-1))^2``,
+    whose sine modes diagonalise the second difference; Euler's ``pi^2 k l / L^2`` as
+    n -> oo). Panels 1e7 x stiffer than the creases: the links are rigid to ~1e-6."""
+    ell, k = 1.0, 2.0
+    m, S, P = _strip(n, ell=ell, k=k)
+    res = linear_buckling(m, P, S, n_modes=3)
+    j = np.arange(1, min(3, n - 1) + 1)
+    expect = 4 * k / ell * np.sin(j * np.pi / (2 * n)) ** 2
+    np.testing.assert_allclose(res.factors[: len(j)], expect, rtol=1e-5)
+    # the first mode is the half sine: the crease nodes move out of plane as sin(pi x / L)
+    x = m.X0[: n + 1, 0]
+    w = res.modes[0, : n + 1, 2]
+    shape = np.sin(np.pi * x / (n * ell))
+    np.testing.assert_allclose(w / w[np.argmax(np.abs(w))], shape / shape.max(), atol=1e-5)
+
+
+def test_tension_only_has_no_buckling_factor():
+    m, S, P = _strip(3)
+    with pytest.raises(BucklingError, match="nothing in compression"):
+        linear_buckling(m, -P, S)
+
+
+def test_mechanism_is_a_named_error():
+    m, S, P = _strip(3)
+    S[:] = False
+    S[0] = True
+    with pytest.raises(BucklingError, match="singular|mechanism"):
+        linear_buckling(m, P, S)
+
+
+def test_modes_are_written_as_vtu(tmp_path):
+    import meshio
+
+    from barhinge.modes_vtu import write_mode_vtus
+
+    m, S, P = _strip(3)
+    res = linear_buckling(m, P, S, n_modes=2)
+    paths = write_mode_vtus(tmp_path, m, res.X, res.modes, res.factors)
+    assert [p.name for p in paths] == ["buckling_mode_1.vtu", "buckling_mode_2.vtu"]
+    back = meshio.read(paths[0])
+    np.testing.assert_allclose(back.points, res.X, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(back.point_data["mode"], res.modes[0], rtol=0, atol=1e-12)

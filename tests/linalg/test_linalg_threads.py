@@ -1,0 +1,96 @@
+"""The thread policy: limits applied inside barhinge's public calls and restored after.
+
+Checked against threadpoolctl's own report of the libraries' thread counts (an independent
+reading of what the BLAS libraries are set to)."""
+
+from __future__ import annotations
+
+import importlib
+
+import pytest
+from threadpoolctl import threadpool_info
+
+import barhinge as bh
+from barhinge.errors import ConfigError
+from barhinge.linalg import threads
+
+
+def blas_threads() -> dict[str, int]:
+    """Threads of each loaded BLAS library (OpenMP runtimes left out: barhinge limits the
+    BLAS libraries themselves)."""
+    return {
+        d["internal_api"]: d["num_threads"] for d in threadpool_info() if d["user_api"] == "blas"
+    }
+
+
+@pytest.mark.parametrize(
+    ("raw", "want"), [("", "auto"), ("AUTO", "auto"), ("off", "off"), ("3", 3)]
+)
+def test_policy_from_the_environment(monkeypatch, raw, want):
+    monkeypatch.setenv(threads.ENV, raw)
+    assert threads.policy() == want
+
+
+@pytest.mark.parametrize("raw", ["0", "-2", "many", "1.5"])
+def test_bad_policy_is_a_one_line_error(monkeypatch, raw):
+    monkeypatch.setenv(threads.ENV, raw)
+    with pytest.raises(ConfigError, match="BARHINGE_THREADS"):
+        threads.policy()
+
+
+def test_dense_calls_use_one_blas_thread_and_restore(monkeypatch):
+    monkeypatch.delenv(threads.ENV, raising=False)
+    before = blas_threads()
+    with threads.dense_calls():
+        inside = blas_threads()
+    assert set(inside.values()) == {1}
+    assert blas_threads() == before
+
+
+def test_sparse_solves_match_mkl_to_the_free_cores(monkeypatch):
+    pytest.importorskip("pypardiso")  # loads MKL
+    monkeypatch.delenv(threads.ENV, raising=False)
+    monkeypatch.setattr(threads, "free_cores", lambda: 1)
+    before = blas_threads()
+    assert "mkl" in before
+    with threads.sparse_solves():
+        inside = blas_threads()
+    assert all(v == 1 for v in inside.values()), inside
+    assert blas_threads() == before
+
+
+def test_off_changes_nothing_and_a_number_sets_every_library(monkeypatch):
+    before = blas_threads()
+    monkeypatch.setenv(threads.ENV, "off")
+    with threads.dense_calls(), threads.sparse_solves():
+        assert blas_threads() == before
+    monkeypatch.setenv(threads.ENV, "1")
+    with threads.sparse_solves():
+        assert set(blas_threads().values()) == {1}
+
+
+def test_free_cores_subtracts_the_load(monkeypatch):
+    monkeypatch.setattr(threads, "cores", lambda: 8)
+    monkeypatch.setattr(threads.os, "getloadavg", lambda: (3.4, 0.0, 0.0))
+    assert threads.free_cores() == 6  # 8 cores, 3 taken by others, this process counts itself
+    monkeypatch.setattr(threads.os, "getloadavg", lambda: (40.0, 0.0, 0.0))
+    assert threads.free_cores() == 1
+
+
+def test_public_calls_run_under_the_policy(monkeypatch):
+    """rigid_fold and dof run their dense work with one BLAS thread (read from inside)."""
+    monkeypatch.delenv(threads.ENV, raising=False)
+    dofmod = importlib.import_module("barhinge.kinematics.dof")
+
+    seen: list[dict[str, int]] = []
+    real = dofmod.RigidConstraints
+
+    class Spy(real):  # type: ignore[misc,valid-type]
+        def __init__(self, *a, **k):
+            seen.append(blas_threads())
+            super().__init__(*a, **k)
+
+    monkeypatch.setattr(dofmod, "RigidConstraints", Spy)
+    bh.dof(bh.patterns.miura(2, 2))
+    assert seen and all(set(s.values()) == {1} for s in seen)
+    assert bh.dof.__name__ == "dof" and "Parameters" in (bh.dof.__doc__ or "")

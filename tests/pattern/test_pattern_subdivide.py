@@ -1,0 +1,55 @@
+"""Panel subdivision keeps the surface, the creases and the vertex ids."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import barhinge as bh
+from barhinge.errors import PatternError
+from barhinge.pattern.subdivide import subdivided
+
+
+def _area(cp) -> float:
+    X = np.asarray(cp.vertices3d)
+    return sum(
+        0.5 * np.linalg.norm(np.cross(X[list(f)], np.roll(X[list(f)], -1, 0)).sum(0))
+        for f in cp.faces
+    )
+
+
+@pytest.mark.parametrize(
+    "cp",
+    [bh.patterns.miura(2, 2, fold=50.0), bh.patterns.yoshimura(3, 2, fold=20.0)],
+    ids=["quads", "triangles"],
+)
+@pytest.mark.parametrize("m", [2, 3])
+def test_subdivision_keeps_surface_creases_and_ids(cp, m):
+    out, parent = subdivided(cp, m)
+    assert out.n_faces == m * m * cp.n_faces
+    assert _area(out) == pytest.approx(_area(cp), rel=1e-12)
+    np.testing.assert_array_equal(np.asarray(out.vertices3d)[: cp.n_vertices], cp.vertices3d)
+    # the folded state is unchanged: every line's state angle is its fold angle (F lines 0)
+    np.testing.assert_allclose(out.state_fold_angles(), out.fold_angles, rtol=0, atol=1e-9)
+    crease = lambda c: np.isin(np.asarray(c.assignment), ["M", "V"])  # noqa: E731
+    assert crease(out).sum() == m * crease(cp).sum()
+    # new vertices on an edge lie on it
+    X, V, E = np.asarray(out.vertices3d), np.asarray(cp.vertices3d), np.asarray(cp.edges)
+    on = np.flatnonzero(parent >= 0)
+    a, b = V[E[parent[on], 0]], V[E[parent[on], 1]]
+    d = np.linalg.norm(np.cross(X[on] - a, b - a), axis=1) / np.linalg.norm(b - a, axis=1)
+    assert d.max() < 1e-12
+
+
+def test_pentagons_are_refused():
+    from barhinge.pattern.crease import CreasePattern
+
+    t = 2 * np.pi * np.arange(5) / 5
+    cp = CreasePattern(
+        np.column_stack([np.cos(t), np.sin(t)]),
+        [[i, (i + 1) % 5] for i in range(5)],
+        ["B"] * 5,
+        faces=[list(range(5))],
+    )
+    with pytest.raises(PatternError, match="5 corners"):
+        subdivided(cp, 2)
