@@ -343,9 +343,21 @@ def fold_cmd(
             "result folder (a previous result folder is always replaced whole).",
         ),
     ] = False,
+    pictures: Annotated[
+        str | None,
+        typer.Option(
+            "--pictures",
+            help="none: no pictures; png: the final state and the charts (default); all: and "
+            "the energy-density picture and the GIF of the path.",
+        ),
+    ] = None,
+    viewer: Annotated[
+        bool,
+        typer.Option("--viewer/--no-viewer", help="Write the interactive viewer.html."),
+    ] = True,
 ) -> None:
-    """Fold a scene: solve it step by step, write the fold path, one summary and one step
-    table (docs/outputs.md).
+    """Fold a scene: solve it step by step, write the fold path, one summary, one step
+    table and the interactive viewer (docs/outputs.md).
 
     The output folder is replaced atomically at the end; Ctrl-C writes the converged steps
     and exits with code 130.
@@ -353,14 +365,16 @@ def fold_cmd(
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from barhinge.output.folder import check_output_folder
-    from barhinge.output.run import write_run
+    from barhinge.output.run import picture_level, write_run
     from barhinge.results import Interrupted
     from barhinge.scene import default_scene, load_scene
     from barhinge.solve.form import form_only_model, rigid_form
     from barhinge.solve.newton import solve
 
+    level = picture_level(pictures)  # a bad value stops before the solve
     scene = default_scene() if scene_file is None else load_scene(scene_file)
     check_output_folder(out, overwrite=overwrite)  # before the solve, not after
+    opts = {"overwrite": overwrite, "pictures": level, "viewer": viewer}
     if form_only and form_only_model(scene)[0] == "rigid":
         try:
             rigid = rigid_form(scene)
@@ -368,8 +382,8 @@ def fold_cmd(
             err_console.print(f"rigid kinematics cannot fold it ({exc}); using the bar-and-hinge "
                               "model", highlight=False, markup=False, soft_wrap=True)  # fmt: skip
         else:
-            run = write_run(rigid, scene, out, overwrite=overwrite, command="fold --form-only",
-                            fields=False)  # fmt: skip
+            run = write_run(rigid, scene, out, command="fold --form-only", fields=False,
+                            **opts)  # fmt: skip
             _print_run(run, f"fold --form-only: {scene.name} (rigid kinematics)", as_json)
             return
     bar = Progress(
@@ -394,12 +408,12 @@ def fold_cmd(
                         part = dataclasses.replace(
                             part, message=part.message.replace("(Ctrl-C)", "(SIGTERM)")
                         )
-                    write_run(part, scene, out, overwrite=overwrite)
+                    write_run(part, scene, out, **opts)
                     _print_events(part.meta.get("events", []), err_console)
                     err_console.print(f"partial results ({part.n_states} states) in {out}",
                                       highlight=False, markup=False)  # fmt: skip
                 raise
-        run = write_run(path, scene, out, overwrite=overwrite)
+        run = write_run(path, scene, out, **opts)
     except Interrupted as exc:
         stop = _terminated(exc)
         part = exc.last_state

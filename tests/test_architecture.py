@@ -66,10 +66,10 @@ LAYERS: list[tuple[str, list[str]]] = [
         ],
     ),
     ("plot", ["barhinge.plot", "barhinge.plot.*"]),
-    # the one writer of a run (run.py) and its pictures (pictures.py)
-    ("output", ["barhinge.output", "barhinge.output.*"]),
-    # the interactive HTML viewer of a result folder (it reads what output/ wrote)
+    # the interactive HTML viewer of a result folder (it reads the output data files)
     ("view", ["barhinge.view", "barhinge.view.*"]),
+    # the one writer of a run (run.py: files, pictures, the viewer) and its pictures
+    ("output", ["barhinge.output", "barhinge.output.*"]),
     ("apps", ["barhinge.verify", "barhinge.sweep"]),
     ("cli", ["barhinge.cli", "barhinge.__main__"]),
     ("api", ["barhinge"]),

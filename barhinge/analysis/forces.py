@@ -227,6 +227,7 @@ def state_results(
     loads: np.ndarray | None = None,
     load_factor: float = 1.0,
     groups: dict[str, Any] | None = None,
+    reactions: np.ndarray | None = None,
 ) -> StateResults:
     """Reactions, bar forces, panel stress resultants, hinge moments and the largest
     displacement at the state ``X``.
@@ -242,6 +243,14 @@ def state_results(
         Reference loads ``P``; the applied loads are ``load_factor * P``.
     groups : dict name -> node ids, optional
         Support groups (default :func:`support_groups`).
+    reactions : (n_nodes, 3) float, optional
+        The reactions the solver recorded (``FoldPath.reactions``): needed when actuators
+        act, whose constraint forces the model's internal force does not include. Default:
+        ``f_int - load_factor * P`` at the fixed DOFs.
+
+    The equilibrium errors are relative to the forces at play, ``sum |R_i| + sum |lambda P_i|
+    + sum |f_int,i|`` over the nodes (times the extent of ``X`` for moments; zero when no
+    force acts).
     """
     n = model.n_nodes
     X = np.asarray(X, float).reshape(n, 3)
@@ -255,6 +264,8 @@ def state_results(
     ev = model.evaluate(X, tangent=False)
     fint = ev.force.reshape(n, 3)
     R = np.where(F, fint - lam * P, 0.0)
+    if reactions is not None:
+        R = np.where(F, np.asarray(reactions, float).reshape(n, 3), 0.0)
     if groups is None:
         groups = support_groups(model, F)
     gnodes = {str(k): np.asarray(v, np.int64).ravel() for k, v in groups.items()}
@@ -263,12 +274,16 @@ def state_results(
             raise ConfigError(f"support group {k!r} names a node outside 0..{n - 1}")
     rgroups = {k: R[v].sum(axis=0) for k, v in gnodes.items()}
     Rt, Pt = R.sum(axis=0), lam * P.sum(axis=0)
-    scale = float(np.linalg.norm(Pt)) or 1.0
-    eq = float(np.linalg.norm(Rt + Pt)) / scale
+    flow = float(
+        np.linalg.norm(R, axis=1).sum()
+        + np.linalg.norm(lam * P, axis=1).sum()
+        + np.linalg.norm(fint, axis=1).sum()
+    )
+    eq = float(np.linalg.norm(Rt + Pt)) / flow if flow > 0 else 0.0
     mR = np.cross(X, R).sum(axis=0)
     mP = np.cross(X, lam * P).sum(axis=0)
-    mscale = float(np.linalg.norm(mR) + np.linalg.norm(mP)) or 1.0
-    meq = float(np.linalg.norm(mR + mP)) / mscale
+    mscale = flow * float(np.linalg.norm(np.ptp(X, axis=0)))
+    meq = float(np.linalg.norm(mR + mP)) / mscale if mscale > 0 else 0.0
     U = X - np.asarray(model.X0, float)
     u = np.linalg.norm(U, axis=1)
     imax = int(np.argmax(u))
@@ -303,24 +318,30 @@ def state_results(
 
 
 def scene_state_results(
-    scene: Any, X: np.ndarray, load_factor: float = 1.0, groups: dict[str, Any] | None = None
+    scene: Any,
+    X: np.ndarray,
+    load_factor: float = 1.0,
+    groups: dict[str, Any] | None = None,
+    reactions: np.ndarray | None = None,
 ) -> StateResults:
     """:func:`state_results` of a ``Scene`` at ``X``: supports and prescribed DOFs are the
     fixed DOFs, the scene's loads the reference loads."""
     fixed = np.asarray(scene.supports, bool).copy()
     if scene.prescribed is not None:
         fixed |= np.isfinite(np.asarray(scene.prescribed, float))
-    return state_results(scene.model, X, fixed, scene.loads, load_factor, groups)
+    return state_results(scene.model, X, fixed, scene.loads, load_factor, groups, reactions)
 
 
 def path_state_results(
     fold_path: Any, scene: Any, step: int = -1, groups: dict[str, Any] | None = None
 ) -> StateResults:
-    """:func:`scene_state_results` at state ``step`` of a solved ``FoldPath``."""
+    """:func:`scene_state_results` at state ``step`` of a solved ``FoldPath``, with the
+    reactions the solver recorded (they include the actuators' constraint forces)."""
     lam = 1.0
     if fold_path.load_factor is not None:
         lam = float(np.asarray(fold_path.load_factor)[step])
-    return scene_state_results(scene, np.asarray(fold_path.X)[step], lam, groups)
+    R = None if fold_path.reactions is None else np.asarray(fold_path.reactions)[step]
+    return scene_state_results(scene, np.asarray(fold_path.X)[step], lam, groups, reactions=R)
 
 
 def results_summary(res: StateResults) -> dict[str, Any]:

@@ -4,8 +4,9 @@
 
 A run writes ``fold_path.npz`` (the path), ``summary.json`` (one summary), ``states.csv``
 (one step table), the fields (``fold_path.xdmf``/``.h5``, ``fold_path_bars.xdmf``/``.h5``,
-``fold_path_NNNN.vtu``), FOLD frames (``fold_path.fold``), the pictures and the manifest
-``barhinge-run.json``; docs/outputs.md lists every file with its columns and units.
+``fold_path_NNNN.vtu``), FOLD frames (``fold_path.fold``), the interactive viewer
+(``viewer.html``), the pictures and the manifest ``barhinge-run.json``; docs/outputs.md lists
+every file with its columns and units.
 """
 
 from __future__ import annotations
@@ -25,12 +26,32 @@ from barhinge.output.summary import run_summary, stop_reason, summary_rows
 from barhinge.output.table import step_table, write_step_table
 from barhinge.results import FoldPath
 
-__all__ = ["RunOutput", "write_results", "write_run"]
+__all__ = ["PICTURES", "RunOutput", "picture_level", "write_results", "write_run"]
 
 log = logging.getLogger(__name__)
 
 #: the files of one run that are not optional extras
 SUMMARY, STEPS = "summary.json", "states.csv"
+#: the interactive viewer of a run (:mod:`barhinge.view`)
+VIEWER = "viewer.html"
+#: what ``pictures`` may ask for: no pictures, the PNGs and charts, or those and the GIF
+PICTURES = ("none", "png", "all")
+
+
+def picture_level(pictures: str | bool | None) -> str:
+    """``"none"``, ``"png"`` or ``"all"`` from an option value: None reads the environment
+    (``BARHINGE_PICTURES=0|none|png|all``; default ``"png"``), True means ``"png"`` and False
+    ``"none"``."""
+    if pictures is None:
+        raw = os.environ.get("BARHINGE_PICTURES", "").strip().lower()
+        pictures = {"0": "none", "1": "png", "": "png"}.get(raw, raw)
+        if pictures == "none":
+            log.info("BARHINGE_PICTURES: no pictures")
+    if isinstance(pictures, bool):
+        return "png" if pictures else "none"
+    if pictures not in PICTURES:
+        raise ConfigError(f"pictures = {pictures!r}; expected one of {', '.join(PICTURES)}")
+    return pictures
 
 
 @dataclasses.dataclass(frozen=True)
@@ -75,7 +96,7 @@ def _write(
     scene: Any | None,
     vtu: str,
     fields: bool,
-    pictures: bool,
+    pictures: str,
     npz: bool,
     fixed: Any | None,
     loads: Any | None,
@@ -97,6 +118,8 @@ def _write(
         except Exception as exc:  # noqa: BLE001 - analysis is an extra; keep the run
             log.warning("final-state analysis not written: %s", exc)
             results = {}
+    if scene is not None and fold_path.kind == "bar-hinge" and model is not None:
+        results = {**results, "forces": _forces(fold_path, scene)}
     summary = jsonable({**run_summary(fold_path, scene), "results": results}, nan=False)
     written["json"] = out / SUMMARY
     written["json"].write_text(json.dumps(summary, indent=2) + "\n")
@@ -109,9 +132,22 @@ def _write(
     return written, summary
 
 
-def _extras(fold_path, model, cp, out: Path, name: str, vtu: str, fields: bool, pictures: bool,
+def _forces(fold_path: FoldPath, scene: Any) -> dict[str, Any]:
+    """Reactions, member forces, moments and the largest displacement at the last state
+    (:mod:`barhinge.analysis.forces`); an empty record (and a warning) if they fail."""
+    from barhinge.analysis.forces import path_state_results, results_summary
+
+    try:
+        return results_summary(path_state_results(fold_path, scene, step=-1))
+    except Exception as exc:  # noqa: BLE001 - an extra of the summary; keep the run
+        log.warning("forces and reactions not written: %s", exc)
+        return {}
+
+
+def _extras(fold_path, model, cp, out: Path, name: str, vtu: str, fields: bool, pictures: str,
             marks: dict[str, Any]):  # fmt: skip
-    """FOLD frames, then (``fields``) XDMF and VTU files, then (``pictures``) pictures."""
+    """FOLD frames, then (``fields``) XDMF and VTU files, then pictures (``"png"``: the final
+    state and the charts; ``"all"``: and the energy-density picture and the GIF)."""
     from barhinge.pattern.fold import write_fold_path
 
     written: dict[str, Path] = {"fold": write_fold_path(cp, fold_path, out / f"{name}.fold")}
@@ -128,11 +164,15 @@ def _extras(fold_path, model, cp, out: Path, name: str, vtu: str, fields: bool, 
                 X_ref=fold_path.X[0],
                 fold_angles_deg=fold_path.fold_angles_deg[s] if model is None else None,
             )
-    if pictures:
+    if pictures != "none":
         from barhinge.output.pictures import write_pictures
 
         try:
-            written.update(write_pictures(fold_path, model, out, pattern=cp, name=name, **marks))
+            every = pictures == "all"  # "png": the final state and the charts only
+            written.update(write_pictures(fold_path, model, out, pattern=cp, name=name,
+                                          gif=every,
+                                          extra_arrays=("energy_density",) if every else (),
+                                          **marks))  # fmt: skip
         except Exception as exc:  # noqa: BLE001 - pictures are optional; never lose results
             log.warning("pictures not written: %s", exc)
     return written
@@ -150,7 +190,7 @@ def write_results(
     fixed: Any | None = None,
     loads: Any | None = None,
     npz: bool = True,
-    pictures: bool = False,
+    pictures: str | bool = False,
 ) -> dict[str, Path]:
     """Write the files of a fold path into ``out_dir`` as it is (created if missing; not
     atomic: :func:`write_run` writes a whole result folder).
@@ -177,8 +217,9 @@ def write_results(
         Supports and load case of the scene (for the stiffness in the summary).
     npz : bool
         Also save the path itself (``<name>.npz``).
-    pictures : bool
-        Also draw the pictures (:func:`barhinge.output.pictures.write_pictures`).
+    pictures : {"none", "png", "all"} or bool
+        Also draw the pictures (:func:`barhinge.output.pictures.write_pictures`): the state
+        pictures and charts (``"png"`` or True), and the GIF too (``"all"``).
 
     Returns
     -------
@@ -186,17 +227,10 @@ def write_results(
     ``vtu``: the last one written, and the picture kinds) to its path.
     """
     files, _ = _write(fold_path, model, Path(out_dir), pattern=pattern, name=name, scene=None,
-                      vtu=vtu, fields=True, pictures=pictures, npz=npz, fixed=fixed,
+                      vtu=vtu, fields=True, pictures=picture_level(pictures), npz=npz,
+                      fixed=fixed,
                       loads=loads, results=results)  # fmt: skip
     return files
-
-
-def _pictures_wanted() -> bool:
-    """False when the environment sets ``BARHINGE_PICTURES=0``."""
-    if os.environ.get("BARHINGE_PICTURES", "").strip() == "0":
-        log.info("BARHINGE_PICTURES=0: no pictures")
-        return False
-    return True
 
 
 def write_run(
@@ -207,7 +241,8 @@ def write_run(
     overwrite: bool = False,
     command: str = "fold",
     fields: bool = True,
-    pictures: bool | None = None,
+    pictures: str | bool | None = None,
+    viewer: bool = True,
 ) -> RunOutput:
     """Write a run into the result folder ``out_dir`` atomically.
 
@@ -230,8 +265,13 @@ def write_run(
         Recorded in the manifest.
     fields : bool
         Write the XDMF and VTU files (``fold --form-only`` does not).
-    pictures : bool, optional
-        Draw the pictures; default unless the environment sets ``BARHINGE_PICTURES=0``.
+    pictures : {"none", "png", "all"}, optional
+        ``"png"``: the final state and the charts; ``"all"``: and the energy-density picture
+        and the GIF of the path;
+        ``"none"``: no pictures. Default from ``BARHINGE_PICTURES`` (``0`` or ``none``,
+        ``png``, ``all``), else ``"png"``. (``fields=False`` draws none.)
+    viewer : bool
+        Write the interactive viewer ``viewer.html`` (:func:`barhinge.view.write_viewer`).
 
     Raises
     ------
@@ -239,14 +279,16 @@ def write_run(
         ``out_dir`` is a file, or a non-empty folder that is not a barhinge result folder
         (without ``overwrite``).
     """
-    want_pictures = _pictures_wanted() if pictures is None else pictures
+    level = picture_level(pictures)
     model = scene.model
     with result_folder(out_dir, overwrite=overwrite, command=command) as run:
         _, summary = _write(fold_path, model, run.path, pattern=model.pattern,
                                   name="fold_path", scene=scene, vtu="all", fields=fields,
-                                  pictures=fields and want_pictures, npz=True,
+                                  pictures=level if fields else "none", npz=True,
                                   fixed=getattr(scene, "fixed", None),
                                   loads=getattr(scene, "loads", None), results=None)  # fmt: skip
+        if viewer:
+            _write_viewer(run.path)
         run.manifest.update(
             scene=summary["scene"],
             kind=fold_path.kind,
@@ -260,3 +302,15 @@ def write_run(
     out = Path(out_dir)
     files = [*(out / n for n in names), out / MANIFEST]
     return RunOutput(out, files, summary, summary_rows(summary, fold_path))
+
+
+def _write_viewer(folder: Path) -> Path | None:
+    """``viewer.html`` of the result folder being written; a warning (not a failure) if it
+    cannot be made: the solved path is never lost for a picture."""
+    from barhinge.view import write_viewer
+
+    try:
+        return write_viewer(folder, folder / VIEWER)
+    except Exception as exc:  # noqa: BLE001 - the viewer is an extra; keep the run
+        log.warning("viewer not written: %s", exc)
+        return None

@@ -182,6 +182,26 @@ def _results_rows(s: dict[str, Any]) -> list[tuple[str, str]]:
     add("mean curvature H (global form)", "H_global")
     add("max |angle defect| (deg)", "max_abs_angle_defect_deg", "{:.3g}")
     add("max |bar strain|", "max_abs_bar_strain", "{:.3g}")
+    f = s.get("forces") or {}
+    if f.get("max_displacement") is not None:
+        rows.append(
+            (
+                "max displacement (node)",
+                f"{f['max_displacement']:.4g} ({f['max_displacement_node']})",
+            )
+        )
+    if f.get("reaction_total") is not None and any(f.get("reactions_by_support") or {}):
+        rx, ry, rz = f["reaction_total"]
+        rows.append(("reaction total (x, y, z)", f"{rx:.4g}, {ry:.4g}, {rz:.4g}"))
+    if f.get("max_tension") is not None:
+        rows.append(
+            (
+                "max bar tension / compression",
+                f"{f['max_tension']:.4g} / {f['max_compression']:.4g}",
+            )
+        )
+    if f.get("max_crease_moment"):
+        rows.append(("max |crease moment|", f"{f['max_crease_moment']:.4g}"))
     if s.get("lowest_eigenvalues"):
         rows.append(
             ("lowest tangent eigenvalue (actuators released)", f"{s['lowest_eigenvalues'][0]:.4g}")

@@ -184,7 +184,7 @@ def test_fold_form_only_writes_a_manifest(tmp_path):
     assert res.exit_code == 0, res.output
     man = read_manifest(out)
     assert man["kind"] == "rigid" and set(man["files"]) == {
-        "fold_path.npz", "fold_path.fold", "summary.json", "states.csv"}  # fmt: skip
+        "fold_path.npz", "fold_path.fold", "summary.json", "states.csv", "viewer.html"}  # fmt: skip
 
 
 # --------------------------------------------------------------------------- Ctrl-C
