@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from barhinge.analysis.curvature import angle_defect, mixed_voronoi_area, pattern_triangles
+from barhinge.analysis.forces import bar_axial_forces
 from barhinge.errors import ConfigError
 from barhinge.results import FoldPath
 
@@ -91,6 +92,7 @@ def state_data(
     pattern: Any | None = None,
     X_ref: np.ndarray | None = None,
     fold_angles_deg: np.ndarray | None = None,
+    reactions: np.ndarray | None = None,
 ) -> StateData:
     """Mesh and data arrays of one state.
 
@@ -106,16 +108,23 @@ def state_data(
         Reference coordinates for ``displacement`` (default: ``model.X0`` or X itself).
     fold_angles_deg : (n_edges,) float, optional
         Fold angles per pattern edge (without a model; default: measured from X).
+    reactions : (n_nodes, 3) float, optional
+        Support reactions of the state (``FoldPath.reactions[s]``); written as point data
+        ``reaction`` (force; zero at free nodes).
 
     Arrays
     ------
-    point data: ``displacement`` (n, 3), ``angle_defect`` (rad, NaN at the boundary),
-    ``defect_density`` (angle defect / mixed Voronoi area, 1/length^2).
+    Units are the user's: lengths of the pattern, forces consistent with its ``E``.
+    point data: ``displacement`` (n, 3, length), ``angle_defect`` (rad, NaN at the
+    boundary), ``defect_density`` (angle defect / mixed Voronoi area, 1/length^2),
+    ``reaction`` (n, 3, force; when ``reactions`` is given).
     cell data (triangle and line blocks): ``fold_angle_deg`` (lines on creases; FOLD sign),
     ``bar_strain`` (engineering strain (L - L0)/L0 of bars), ``energy_density`` (bars and fold
     hinges: energy per unit length; panels: bending energy per unit area; the model's own
     laws of :mod:`barhinge.kernels.laws`), ``kind`` (0 panel, 1 bar inside a panel, 2 crease,
-    3 other pattern edge: boundary or flat line).
+    3 other pattern edge: boundary or flat line); with a model also ``bar_force`` (lines: axial
+    force, tension > 0, force) and ``moment`` (lines on creases: the fold hinge's moment
+    ``dW/drho``, > 0 folding it further valley than its rest angle, force x length).
     """
     X = np.asarray(X, dtype=float)
     if X.ndim != 2 or X.shape[1] != 3:
@@ -135,6 +144,8 @@ def state_data(
         rho = np.asarray(model.hinge_angles(X), float)
         e_line, e_h = _element_energies(model, X, rho)
         e_line = e_line / L0  # energy per length
+        bar_force = bar_axial_forces(model, X)
+        hinge_moment = np.asarray(model.evaluate(X, tangent=False).hinge_moment, float)
         kind = np.asarray(model.hinge_kind)
         fold = kind == "fold"
         H = np.asarray(model.hinges, np.int64)
@@ -149,6 +160,8 @@ def state_data(
         ok = key_line[order[at]] == key_h
         i, hf = order[at[ok]], hf[ok]
         fold_ang[i] = np.degrees(rho[hf])
+        moment_line = np.full(len(lines), np.nan)
+        moment_line[i] = hinge_moment[hf]
         np.add.at(e_line, i, e_h[hf] / L0[i])
         is_crease[i] = True
         # bend hinges: energy split between their two triangles, per unit area
@@ -183,6 +196,7 @@ def state_data(
         e_line = np.full(len(lines), np.nan)
         e_tri = np.full(len(tri), np.nan)
         kind_line = np.where(crease, 2, 3)
+        bar_force = moment_line = None
         Xr = cp.vertices3d if X_ref is None else X_ref
     Xr = np.asarray(Xr, float)
     disp = X - Xr if Xr.shape == X.shape else np.zeros_like(X)
@@ -190,23 +204,31 @@ def state_data(
     with np.errstate(divide="ignore", invalid="ignore"):
         density = defect / mixed_voronoi_area(X, tri)
     nan_t = np.full(len(tri), np.nan)
+    point_data = {"displacement": disp, "angle_defect": defect, "defect_density": density}
+    if reactions is not None:
+        point_data["reaction"] = np.asarray(reactions, float).reshape(n, 3)
+    triangle_data = {
+        "fold_angle_deg": nan_t,
+        "bar_strain": nan_t,
+        "energy_density": e_tri,
+        "kind": np.zeros(len(tri)),
+    }
+    line_data = {
+        "fold_angle_deg": fold_ang,
+        "bar_strain": strain_line,
+        "energy_density": e_line,
+        "kind": kind_line.astype(float),
+    }
+    if bar_force is not None:
+        triangle_data["bar_force"] = triangle_data["moment"] = nan_t
+        line_data["bar_force"], line_data["moment"] = bar_force, moment_line
     return StateData(
         points=X,
         triangles=tri,
         lines=lines,
-        point_data={"displacement": disp, "angle_defect": defect, "defect_density": density},
-        triangle_data={
-            "fold_angle_deg": nan_t,
-            "bar_strain": nan_t,
-            "energy_density": e_tri,
-            "kind": np.zeros(len(tri)),
-        },
-        line_data={
-            "fold_angle_deg": fold_ang,
-            "bar_strain": strain_line,
-            "energy_density": e_line,
-            "kind": kind_line.astype(float),
-        },
+        point_data=point_data,
+        triangle_data=triangle_data,
+        line_data=line_data,
     )
 
 
@@ -266,8 +288,9 @@ def write_xdmf(
     """Write a fold path as XDMF time series: ``<stem>.xdmf`` (panels, triangles) and
     ``<stem>_bars.xdmf`` (bars or edges, lines), each with its ``.h5`` beside it.
 
-    The mesh is state 0; each step holds point data ``displacement`` (from state 0) and the
-    arrays of :func:`state_data`. The time value of step s is s.
+    The mesh is state 0; each step holds point data ``displacement`` (from state 0), the
+    support ``reaction`` where the path records reactions, and the arrays of
+    :func:`state_data`. The time value of step s is s.
 
     meshio's time-series writer creates its ``.h5`` in the current directory, so it is run
     from inside the output folder (the working directory is restored afterwards).
@@ -284,6 +307,7 @@ def write_xdmf(
             pattern=pattern,
             X_ref=fold_path.X[0],
             fold_angles_deg=fold_path.fold_angles_deg[s] if model is None else None,
+            reactions=None if fold_path.reactions is None else fold_path.reactions[s],
         )
         for s in range(fold_path.n_states)
     ]

@@ -163,6 +163,7 @@ def _extras(fold_path, model, cp, out: Path, name: str, vtu: str, fields: bool, 
                 pattern=cp if model is None else None,
                 X_ref=fold_path.X[0],
                 fold_angles_deg=fold_path.fold_angles_deg[s] if model is None else None,
+                reactions=None if fold_path.reactions is None else fold_path.reactions[s],
             )
     if pictures != "none":
         from barhinge.output.pictures import write_pictures

@@ -184,3 +184,46 @@ def test_write_results_of_a_bar_hinge_path(tmp_path):
 
         last = read_fold(files["fold"], frame=path.n_states, validate=False)
         np.testing.assert_allclose(last.vertices, X[-1][: cp.n_vertices], atol=1e-9, rtol=0)
+
+
+def test_vtu_force_fields_match_the_strains_and_fold_angles(tmp_path):
+    """bar_force = EA (e + e^2/2)(1 + e) for the default Green-strain bars, e the engineering
+    strain of the bar_strain field (computed from lengths); crease moment = k (rho - rho0)
+    from the fold_angle_deg field; reactions at supports only, summing to the applied load
+    (none here: zero)."""
+    import meshio
+
+    import barhinge as bh
+    from barhinge.output.fields import write_state_vtu
+    from barhinge.scene import Scene, miura_line_creases
+
+    cp = bh.patterns.miura(2, 2, fold=20.0)
+    model = bh.BarHingeModel.from_pattern(cp, material=bh.Material(E=1e3, nu=0.3, t=0.01))
+    edges = miura_line_creases(cp)
+    acts = bh.Actuators(edges=edges, targets_deg=np.asarray(cp.fold_angles)[edges] * 1.5)
+    scene = Scene(model, actuators=acts, steps=6)
+    path = bh.solve(scene)
+    f = write_state_vtu(tmp_path / "s.vtu", path.X[-1], model=model, reactions=path.reactions[-1])
+    m = meshio.read(f)
+    line = [i for i, c in enumerate(m.cells) if c.type == "line"][0]
+    eps = m.cell_data["bar_strain"][line]
+    assert model.strain == "green"
+    want = model.bar_EA * (eps + eps**2 / 2) * (1 + eps)
+    np.testing.assert_allclose(
+        m.cell_data["bar_force"][line], want, rtol=1e-9, atol=1e-12 * np.abs(want).max()
+    )
+    # crease moments from the fold angles of the same lines and the fold hinges' springs
+    fold = np.flatnonzero(model.hinge_kind == "fold")
+    axes = list(map(tuple, np.sort(model.hinges[fold, :2], axis=1)))
+    k = dict(zip(axes, model.hinge_k[fold], strict=True))
+    r0 = dict(zip(axes, model.rest_angle[fold], strict=True))
+    bars = np.sort(m.cells[line].data, axis=1)
+    mom, ang = m.cell_data["moment"][line], m.cell_data["fold_angle_deg"][line]
+    creases = np.flatnonzero(np.isfinite(mom))
+    assert len(creases) == len(fold)
+    for i in creases:
+        key = tuple(bars[i])
+        assert mom[i] == pytest.approx(k[key] * (np.radians(ang[i]) - r0[key]), rel=1e-9, abs=1e-14)
+    R = m.point_data["reaction"]
+    assert np.all(R[~scene.fixed.any(axis=1)] == 0.0)
+    assert np.linalg.norm(R.sum(axis=0)) < 1e-8
