@@ -20,6 +20,7 @@ __all__ = [
     "plot_energy",
     "plot_fold_angles",
     "plot_force_displacement",
+    "plot_load_deflection",
     "plot_poisson",
     "summary_figure",
 ]
@@ -224,15 +225,44 @@ def plot_poisson(
     return _finish(ax, path, "Poisson's ratio")
 
 
+def max_displacement(fold_path: Any) -> tuple[np.ndarray, int]:
+    """(n_states,) largest nodal displacement from state 0 (length) in every state, and the
+    node where the last state's is largest."""
+    X = np.asarray(fold_path.X, float)
+    u = np.linalg.norm(X - X[0], axis=2)
+    return u.max(axis=1), int(np.argmax(u[-1]))
+
+
+def plot_load_deflection(fold_path: Any, ax=None, path: str | Path | None = None):
+    """Load factor against the largest nodal displacement (from state 0) of each state: the
+    load-deflection curve of a load- or arc-length-controlled path (limit points show as
+    turning points)."""
+    ax = _axes(ax)
+    u, node = max_displacement(fold_path)
+    lam = np.asarray(fold_path.load_factor, float)
+    ax.plot(u, lam, "-o", ms=3, color=COLORS[0], label=f"max |u| (node {node} at the end)")
+    ax.set_xlabel("largest displacement |u| (length)")
+    ax.set_ylabel("load factor")
+    ax.axhline(1.0, color="0.6", lw=0.8, ls="--")
+    ax.legend(frameon=False, fontsize="small")
+    return _finish(ax, path, "Load-deflection")
+
+
 def summary_figure(fold_path: Any, path: str | Path | None = None):
-    """Actuator angles and fold angles of all creases, then the energy split and actuator
-    moments where the path has them (not for rigid paths). Returns the figure."""
+    """Actuator angles (when actuators drive the path) and fold angles of all creases, the
+    load-deflection curve under load or arc-length control, then the energy split and
+    actuator moments where the path has them (not for rigid paths). Returns the figure."""
     plt = _plt()
-    panels = [plot_actuator_angles, plot_fold_angles]
+    panels = [plot_fold_angles]
+    if len(np.asarray(fold_path.actuator_edges)):
+        panels.insert(0, plot_actuator_angles)
+    if fold_path.meta.get("control") in ("load", "arc_length"):
+        panels.insert(0, plot_load_deflection)
     energy = np.column_stack([fold_path.energy_bars, fold_path.energy_bend, fold_path.energy_fold])
     if np.isfinite(energy).any():
         panels.append(plot_energy)
-    if np.isfinite(np.asarray(fold_path.actuator_moments, float)).any():
+    moments = np.asarray(fold_path.actuator_moments, float)
+    if moments.size and np.isfinite(moments).any():
         panels.append(plot_actuator_moments)
     shape = (2, 2) if len(panels) == 4 else (1, len(panels))
     size = (11.0, 8.0) if len(panels) == 4 else (5.0 * len(panels), 4.2)
