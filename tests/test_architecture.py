@@ -62,7 +62,7 @@ LAYERS: list[tuple[str, list[str]]] = [
             "barhinge.output.table",
             "barhinge.output.summary",
             "barhinge.output.folder",
-            "barhinge.modes_vtu",
+            "barhinge.output.modes",
         ],
     ),
     ("plot", ["barhinge.plot", "barhinge.plot.*"]),

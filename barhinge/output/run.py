@@ -18,6 +18,8 @@ import os
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from barhinge._json import jsonable
 from barhinge.errors import ConfigError
 from barhinge.output.fields import write_state_vtu, write_xdmf
@@ -120,6 +122,8 @@ def _write(
             results = {}
     if scene is not None and fold_path.kind == "bar-hinge" and model is not None:
         results = {**results, "forces": _forces(fold_path, scene)}
+        if np.any(np.asarray(scene.loads)):
+            results["buckling"] = _buckling(model, scene, out if fields else None)
     summary = jsonable({**run_summary(fold_path, scene), "results": results}, nan=False)
     written["json"] = out / SUMMARY
     written["json"].write_text(json.dumps(summary, indent=2) + "\n")
@@ -142,6 +146,30 @@ def _forces(fold_path: FoldPath, scene: Any) -> dict[str, Any]:
     except Exception as exc:  # noqa: BLE001 - an extra of the summary; keep the run
         log.warning("forces and reactions not written: %s", exc)
         return {}
+
+
+def _buckling(model: Any, scene: Any, folder: Path | None) -> dict[str, Any]:
+    """Linear buckling factors of the reference state under the scene's loads
+    (:func:`barhinge.analysis.buckling.linear_buckling`), and (``folder``) one VTU per mode;
+    a record ``{"error": ...}`` when there is no buckling factor (a mechanism, nothing in
+    compression, an eigensolver failure)."""
+    from barhinge.analysis.buckling import linear_buckling
+    from barhinge.errors import BucklingError
+
+    try:
+        b = linear_buckling(model, scene.loads, scene.fixed, n_modes=3)
+    except BucklingError as exc:
+        return {"error": str(exc)}
+    rec: dict[str, Any] = {"factors": [float(f) for f in b.factors], "state": 0}
+    if folder is not None:
+        from barhinge.output.modes import write_mode_vtus
+
+        try:
+            files = write_mode_vtus(folder, model, b.X, b.modes, b.factors)
+            rec["mode_files"] = [p.name for p in files]
+        except Exception as exc:  # noqa: BLE001 - an extra; keep the run
+            log.warning("buckling modes not written: %s", exc)
+    return rec
 
 
 def _extras(fold_path, model, cp, out: Path, name: str, vtu: str, fields: bool, pictures: str,

@@ -200,6 +200,11 @@ def _results_rows(s: dict[str, Any]) -> list[tuple[str, str]]:
                 f"{f['max_tension']:.4g} / {f['max_compression']:.4g}",
             )
         )
+    b = s.get("buckling") or {}
+    if b.get("factors"):
+        rows.append(("linear buckling factor (state 0)", f"{b['factors'][0]:.4g}"))
+    elif b.get("error"):
+        rows.append(("linear buckling factor (state 0)", "none: " + b["error"].split(": ")[-1]))
     if f.get("max_crease_moment"):
         rows.append(("max |crease moment|", f"{f['max_crease_moment']:.4g}"))
     if s.get("lowest_eigenvalues"):

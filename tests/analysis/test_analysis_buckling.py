@@ -91,7 +91,7 @@ def test_mechanism_is_a_named_error():
 def test_modes_are_written_as_vtu(tmp_path):
     import meshio
 
-    from barhinge.modes_vtu import write_mode_vtus
+    from barhinge.output.modes import write_mode_vtus
 
     m, S, P = _strip(3)
     res = linear_buckling(m, P, S, n_modes=2)

@@ -101,3 +101,28 @@ def test_summary_forces_balance_for_an_actuated_sheet(solved, tmp_path):
     assert f["max_displacement_node"] == int(np.argmax(u))
     rows = dict(summary_rows(run.summary))
     assert rows["max displacement (node)"].endswith(f"({int(np.argmax(u))})")
+
+
+def test_loaded_scene_summary_has_its_linear_buckling_factors_and_modes(tmp_path):
+    """The summary's factors are those of `linear_buckling` on the scene (checked against
+    the strut closed form in tests/analysis/test_analysis_buckling.py); one VTU per mode."""
+    from pathlib import Path
+
+    from barhinge.analysis.buckling import linear_buckling
+    from barhinge.scene import load_scene
+
+    scene = load_scene(Path(__file__).parents[2] / "data/scenes/yoshimura_roof.toml")
+    path = bh.solve(scene)
+    run = write_run(path, scene, tmp_path / "out", pictures="none", viewer=False)
+    rec = run.summary["results"]["buckling"]
+    want = linear_buckling(scene.model, scene.loads, scene.fixed, n_modes=3).factors
+    np.testing.assert_allclose(rec["factors"], want, rtol=1e-8)
+    assert rec["factors"][0] > 0
+    assert {f"buckling_mode_{i}.vtu" for i in (1, 2, 3)} <= names(run)
+    assert "linear buckling factor (state 0)" in dict(summary_rows(run.summary))
+
+
+def test_unloaded_scene_has_no_buckling_record(solved, tmp_path):
+    scene, path = solved
+    run = write_run(path, scene, tmp_path / "out", pictures="none", viewer=False)
+    assert "buckling" not in run.summary["results"]
