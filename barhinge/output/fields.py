@@ -175,6 +175,7 @@ def state_data(
         cp = model.pattern
         on_edge = np.isin(key_line, _pair_index(cp.edges, n))
         kind_line = np.where(is_crease, 2, np.where(on_edge, 3, 1))
+        forces: tuple[np.ndarray, np.ndarray] | None = (bar_force, moment_line)
         Xr = model.X0 if X_ref is None else X_ref
     else:
         cp = pattern
@@ -196,7 +197,7 @@ def state_data(
         e_line = np.full(len(lines), np.nan)
         e_tri = np.full(len(tri), np.nan)
         kind_line = np.where(crease, 2, 3)
-        bar_force = moment_line = None
+        forces = None
         Xr = cp.vertices3d if X_ref is None else X_ref
     Xr = np.asarray(Xr, float)
     disp = X - Xr if Xr.shape == X.shape else np.zeros_like(X)
@@ -219,9 +220,9 @@ def state_data(
         "energy_density": e_line,
         "kind": kind_line.astype(float),
     }
-    if bar_force is not None:
+    if forces is not None:  # a model: bar forces and crease moments on the lines
         triangle_data["bar_force"] = triangle_data["moment"] = nan_t
-        line_data["bar_force"], line_data["moment"] = bar_force, moment_line
+        line_data["bar_force"], line_data["moment"] = forces
     return StateData(
         points=X,
         triangles=tri,
