@@ -14,6 +14,10 @@ import numpy as np
 __all__ = ["draw_dof"]
 
 
+#: label the actuators with their edge ids up to this many
+MAX_LABELS = 40
+
+
 def draw_dof(
     cp: Any,
     report: Any,
@@ -68,6 +72,11 @@ def draw_dof(
         ax.add_collection(
             LineCollection(V[E[acts]], colors="tab:orange", linewidths=3.0, label="actuators")
         )
+        if len(acts) <= MAX_LABELS:  # the edge ids the CLI prints, beside their creases
+            mid = V[E[acts]].mean(axis=1)
+            for e, (x, y) in zip(acts, mid, strict=True):
+                ax.annotate(str(int(e)), (x, y), fontsize=7, color="tab:orange", zorder=4,
+                            xytext=(2, 2), textcoords="offset points")  # fmt: skip
     val = np.asarray(rep.region if which == "region" else rep.local)
     ok = val >= 0
     if ok.any():
@@ -92,7 +101,7 @@ def draw_dof(
     ax.set_title(
         title
         or f"global DOF {rep.global_dof} (count {rep.counted_dof}, redundant {rep.redundant}), "
-        f"{len(acts)} actuators; {state}",
+        f"{len(acts)} actuator{'' if len(acts) == 1 else 's'}; {state}",
         fontsize=9,
     )
     if path is not None:

@@ -48,6 +48,11 @@ def test_draw_dof_returns_figure_with_actuators_marked():
     assert len(ax.collections) == 4
     offsets = ax.collections[-1].get_offsets()
     assert len(offsets) == int(np.sum(rep.folded.local >= 0))
+    # every actuator's edge id is written beside it (the ids `barhinge dof` prints)
+    acts = [int(e) for e in rep.mechanism.actuators]
+    assert sorted(int(t.get_text()) for t in ax.texts) == sorted(acts)
+    n = len(acts)
+    assert f"{n} actuator{'' if n == 1 else 's'};" in ax.get_title()
     import matplotlib.pyplot as plt
 
     plt.close(fig)
