@@ -347,8 +347,8 @@ def fold_cmd(
         str | None,
         typer.Option(
             "--pictures",
-            help="none: no pictures; png: the final state and the charts (default); all: and "
-            "the energy-density picture and the GIF of the path.",
+            help="none: no pictures (default: viewer.html shows the run); png: the final state "
+            "and the charts; all: and the energy-density picture and the GIF of the path.",
         ),
     ] = None,
     viewer: Annotated[

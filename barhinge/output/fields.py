@@ -233,11 +233,16 @@ def state_data(
     )
 
 
-def state_mesh(X: np.ndarray, **kwargs: Any):
-    """A ``meshio.Mesh`` of one state (arguments of :func:`state_data`)."""
+def state_mesh(X: np.ndarray | None = None, *, data: StateData | None = None, **kwargs: Any):
+    """A ``meshio.Mesh`` of one state: from ``data`` when given, else from the arguments of
+    :func:`state_data`."""
     import meshio
 
-    d = state_data(X, **kwargs)
+    if data is None:
+        if X is None:
+            raise ConfigError("state_mesh needs X (with the state_data arguments) or data")
+        data = state_data(X, **kwargs)
+    d = data
     return meshio.Mesh(
         d.points,
         [("triangle", d.triangles), ("line", d.lines)],
@@ -246,8 +251,9 @@ def state_mesh(X: np.ndarray, **kwargs: Any):
     )
 
 
-def write_state_vtu(path: str | Path, X: np.ndarray, **kwargs: Any) -> Path:
-    """Write one state to a ``.vtu`` file (arguments of :func:`state_data`)."""
+def write_state_vtu(path: str | Path, X: np.ndarray | None = None, **kwargs: Any) -> Path:
+    """Write one state to a ``.vtu`` file (``data=`` a :class:`StateData`, or the arguments
+    of :func:`state_data`)."""
     path = Path(path)
     state_mesh(X, **kwargs).write(path)
     return path
@@ -283,25 +289,12 @@ def _cwd(folder: Path) -> Iterator[None]:
         os.chdir(old)
 
 
-def write_xdmf(
-    path: str | Path, fold_path: FoldPath, *, model: Any | None = None, pattern: Any | None = None
-) -> Path:
-    """Write a fold path as XDMF time series: ``<stem>.xdmf`` (panels, triangles) and
-    ``<stem>_bars.xdmf`` (bars or edges, lines), each with its ``.h5`` beside it.
-
-    The mesh is state 0; each step holds point data ``displacement`` (from state 0), the
-    support ``reaction`` where the path records reactions, and the arrays of
-    :func:`state_data`. The time value of step s is s.
-
-    meshio's time-series writer creates its ``.h5`` in the current directory, so it is run
-    from inside the output folder (the working directory is restored afterwards).
-    """
-    import meshio
-
-    given = Path(path)
-    path = given.resolve()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    states = [
+def path_state_data(
+    fold_path: FoldPath, *, model: Any | None = None, pattern: Any | None = None
+) -> list[StateData]:
+    """:func:`state_data` of every state of a path (displacements from state 0, the
+    recorded reactions where the path has them)."""
+    return [
         state_data(
             fold_path.X[s],
             model=model,
@@ -312,6 +305,34 @@ def write_xdmf(
         )
         for s in range(fold_path.n_states)
     ]
+
+
+def write_xdmf(
+    path: str | Path,
+    fold_path: FoldPath,
+    *,
+    model: Any | None = None,
+    pattern: Any | None = None,
+    states: list[StateData] | None = None,
+) -> Path:
+    """Write a fold path as XDMF time series: ``<stem>.xdmf`` (panels, triangles) and
+    ``<stem>_bars.xdmf`` (bars or edges, lines), each with its ``.h5`` beside it.
+
+    ``states``: the :func:`path_state_data` of the path when already computed (the run
+    writer shares them with the VTU files). The mesh is state 0; each step holds point data
+    ``displacement`` (from state 0), the support ``reaction`` where the path records
+    reactions, and the arrays of :func:`state_data`. The time value of step s is s.
+
+    meshio's time-series writer creates its ``.h5`` in the current directory, so it is run
+    from inside the output folder (the working directory is restored afterwards).
+    """
+    import meshio
+
+    given = Path(path)
+    path = given.resolve()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if states is None:
+        states = path_state_data(fold_path, model=model, pattern=pattern)
     lines_path = path.with_name(path.stem + "_bars.xdmf")
     d0 = states[0]
     # meshio's XDMF writer cannot mix triangles and lines in one grid: two files

@@ -22,7 +22,7 @@ import numpy as np
 
 from barhinge._json import jsonable
 from barhinge.errors import ConfigError
-from barhinge.output.fields import write_state_vtu, write_xdmf
+from barhinge.output.fields import path_state_data, write_state_vtu, write_xdmf
 from barhinge.output.folder import MANIFEST, result_folder
 from barhinge.output.summary import run_summary, stop_reason, summary_rows
 from barhinge.output.table import step_table, write_step_table
@@ -42,11 +42,12 @@ PICTURES = ("none", "png", "all")
 
 def picture_level(pictures: str | bool | None) -> str:
     """``"none"``, ``"png"`` or ``"all"`` from an option value: None reads the environment
-    (``BARHINGE_PICTURES=0|none|png|all``; default ``"png"``), True means ``"png"`` and False
-    ``"none"``."""
+    (``BARHINGE_PICTURES=0|none|png|all``; default ``"none"``: the interactive viewer is
+    the picture of a run, and the static pictures cost more than the solve of a small scene),
+    True means ``"png"`` and False ``"none"``."""
     if pictures is None:
         raw = os.environ.get("BARHINGE_PICTURES", "").strip().lower()
-        pictures = {"0": "none", "1": "png", "": "png"}.get(raw, raw)
+        pictures = {"0": "none", "1": "png", "": "none"}.get(raw, raw)
         if pictures == "none":
             log.info("BARHINGE_PICTURES: no pictures")
     if isinstance(pictures, bool):
@@ -180,19 +181,12 @@ def _extras(fold_path, model, cp, out: Path, name: str, vtu: str, fields: bool, 
 
     written: dict[str, Path] = {"fold": write_fold_path(cp, fold_path, out / f"{name}.fold")}
     if fields:
-        written["xdmf"] = write_xdmf(out / f"{name}.xdmf", fold_path, model=model, pattern=cp)
+        states = path_state_data(fold_path, model=model, pattern=cp)  # once, for both files
+        written["xdmf"] = write_xdmf(out / f"{name}.xdmf", fold_path, states=states)
         written["xdmf_bars"] = out / f"{name}_bars.xdmf"
         n = fold_path.n_states
         for s in {"all": range(n), "last": [n - 1], "none": []}[vtu]:
-            written["vtu"] = write_state_vtu(
-                out / f"{name}_{s:04d}.vtu",
-                fold_path.X[s],
-                model=model,
-                pattern=cp if model is None else None,
-                X_ref=fold_path.X[0],
-                fold_angles_deg=fold_path.fold_angles_deg[s] if model is None else None,
-                reactions=None if fold_path.reactions is None else fold_path.reactions[s],
-            )
+            written["vtu"] = write_state_vtu(out / f"{name}_{s:04d}.vtu", data=states[s])
     if pictures != "none":
         from barhinge.output.pictures import write_pictures
 
@@ -298,7 +292,8 @@ def write_run(
         ``"png"``: the final state and the charts; ``"all"``: and the energy-density picture
         and the GIF of the path;
         ``"none"``: no pictures. Default from ``BARHINGE_PICTURES`` (``0`` or ``none``,
-        ``png``, ``all``), else ``"png"``. (``fields=False`` draws none.)
+        ``png``, ``all``), else ``"none"`` (the viewer shows the run). (``fields=False``
+        draws none.)
     viewer : bool
         Write the interactive viewer ``viewer.html`` (:func:`barhinge.view.write_viewer`).
 

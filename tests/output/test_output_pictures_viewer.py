@@ -42,17 +42,25 @@ def names(run) -> set[str]:
     return {p.name for p in run.files}
 
 
-def test_default_writes_the_viewer_and_the_light_pictures(solved, tmp_path, mpl, monkeypatch):
+def test_default_writes_the_viewer_and_no_static_pictures(solved, tmp_path, monkeypatch):
     monkeypatch.delenv("BARHINGE_PICTURES", raising=False)
     scene, path = solved
     run = write_run(path, scene, tmp_path / "out")
     n = names(run)
-    assert {"viewer.html", "fold_path.png", "fold_path_charts.png"} <= n
-    assert "fold_path.gif" not in n and "fold_path_energy_density.png" not in n
+    assert "viewer.html" in n
+    assert not any(p.suffix in (".png", ".gif") for p in run.files)
     html = (tmp_path / "out" / "viewer.html").read_text()
     assert html.lstrip().lower().startswith("<!doctype html") and "http://" not in html.lower()
     manifest = json.loads((tmp_path / "out" / "barhinge-run.json").read_text())
     assert "viewer.html" in json.dumps(manifest)
+
+
+def test_pictures_png_draws_the_final_state_and_the_charts(solved, tmp_path, mpl):
+    scene, path = solved
+    run = write_run(path, scene, tmp_path / "out", pictures="png")
+    n = names(run)
+    assert {"viewer.html", "fold_path.png", "fold_path_charts.png"} <= n
+    assert "fold_path.gif" not in n and "fold_path_energy_density.png" not in n
 
 
 def test_pictures_none_and_no_viewer(solved, tmp_path):
@@ -68,7 +76,7 @@ def test_pictures_all_adds_the_gif_and_the_energy_picture(solved, tmp_path, mpl)
 
 
 @pytest.mark.parametrize(
-    ("env", "want"), [("0", "none"), ("none", "none"), ("png", "png"), ("all", "all"), ("", "png")]
+    ("env", "want"), [("0", "none"), ("none", "none"), ("png", "png"), ("all", "all"), ("", "none")]
 )
 def test_picture_level_from_the_environment(monkeypatch, env, want):
     monkeypatch.setenv("BARHINGE_PICTURES", env)
