@@ -1,7 +1,10 @@
 """Newton step control: iterations and factorisations per step, both stiffness sets.
 
 Run:  python benchmarks/bench_newton.py [--sizes 10 20] [--steps 50] [--repeat 1]
-      [--options '{"predictor": "secant"}']
+      [--options '{"predictor": "secant"}'] [--publish]
+
+``--publish`` also writes the tables into docs/solver-performance.md (between the
+``bench_newton`` markers).
 
 Miura n x n cells folded by actuators on the middle crease line from flat to 60 deg in
 ``--steps`` steps (``bench_solver.miura_scene``), for the quasi-rigid and the compliant
@@ -72,14 +75,21 @@ def main() -> None:
     ap.add_argument("--steps", type=int, default=50)
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--options", default="{}", help="solver options (JSON) for every run")
+    ap.add_argument("--publish", action="store_true", help="write into docs/")
     a = ap.parse_args()
+    lines: list[str] = []
+
+    def out(line: str = "") -> None:
+        print(line, flush=True)
+        lines.append(line)
+
     logging.disable(logging.WARNING)  # the compliant sheet's stability events
     options = json.loads(a.options)
-    print(f"## Newton step control: Miura n x n, flat -> 60 deg in {a.steps} steps")
+    out(f"## Newton step control: Miura n x n, flat -> 60 deg in {a.steps} steps")
     if options:
-        print(f"options: {options}")
-    print("| " + " | ".join(COLS) + " |")
-    print("|" + "---|" * len(COLS))
+        out(f"options: {options}")
+    out("| " + " | ".join(COLS) + " |")
+    out("|" + "---|" * len(COLS))
     ratios = []
     for n in a.sizes:
         rows = {}
@@ -103,13 +113,33 @@ def main() -> None:
                 f"{r['wall']:.2f}",
                 f"{r['cpu']:.2f}",
             )
-            print("| " + " | ".join(str(v) for v in row) + " |", flush=True)
+            out("| " + " | ".join(str(v) for v in row) + " |")
         q, c = rows["quasi-rigid"], rows["compliant"]
         ratios.append((n, c["fact"] / q["fact"], c["wall"] / q["wall"]))
-    print("\n| n | factorisations compliant / quasi-rigid | wall compliant / quasi-rigid |")
-    print("|---|---|---|")
+    out()
+    out("| n | factorisations compliant / quasi-rigid | wall compliant / quasi-rigid |")
+    out("|---|---|---|")
     for n, rf, rw in ratios:
-        print(f"| {n} | {rf:.2f} | {rw:.2f} |")
+        out(f"| {n} | {rf:.2f} | {rw:.2f} |")
+    if a.publish:
+        publish(lines, a)
+
+
+def publish(lines: list[str], a: argparse.Namespace) -> None:
+    """Replace the text between the markers in docs/solver-performance.md."""
+    doc = Path(__file__).resolve().parents[1] / "docs" / "solver-performance.md"
+    text = doc.read_text()
+    start, end = "<!-- bench_newton:start -->", "<!-- bench_newton:end -->"
+    cmd = "python benchmarks/bench_newton.py --publish"
+    if a.options != "{}":
+        cmd += f" --options '{a.options}'"
+    body = "\n".join([start, f"Written by `{cmd}` (this machine).", "", *lines, end])
+    if start in text and end in text:
+        head, rest = text.split(start, 1)
+        text = head + body + rest.split(end, 1)[1]
+    else:
+        text = text.rstrip("\n") + "\n\n" + body + "\n"
+    doc.write_text(text)
 
 
 if __name__ == "__main__":
