@@ -69,16 +69,6 @@ class SolverOptions:
         Maximum halvings of a Newton correction in the backtracking line search on
         ``|r|^2 + (s c)^2`` (0 = plain Newton, the default: on stiff-bar / soft-fold
         mechanisms full Newton steps with cut-back of the increment were measured faster).
-    chord_steps : int
-        After a Newton correction that raised the force residual, up to this many
-        corrections with the same factorisation (chord steps), each kept only if it lowers
-        the residual (0 = off, the default). Near a mechanism (panels only ~100 x stiffer
-        than the folds) the Newton step moves far along a soft mode and the stiff bars it
-        stretches make the residual jump; the old tangent removes that stiff part without a
-        new factorisation. Measured on the compliant 20 x 20 Miura fold: 10-15 % fewer
-        factorisations with 1 (run-to-run spread of the reference ~10 %), none gained with
-        3, and intermediate states inside its negative-stiffness stretch land on a
-        neighbouring equilibrium, so it stays off by default (docs/solver-performance.md).
     reuse_factorization : bool
         Reuse a factorisation over Newton iterations and increments as the preconditioner
         of GMRES on the exact tangent system (a fresh factorisation when GMRES stalls or has
@@ -136,7 +126,6 @@ class SolverOptions:
     augmentation: float | str = "auto"
     predictor: str = "quadratic"
     line_search: int = 0
-    chord_steps: int = 0
     reuse_factorization: bool = False
     krylov_max: int = 30
     arc_length_increment: float | None = None
@@ -169,7 +158,6 @@ class SolverOptions:
         # 2**-60 of a step is below the resolution of the path parameter
         whole("max_cutbacks", 0, 60)
         whole("line_search", 0, 60)
-        whole("chord_steps", 0, MAX_ITERATIONS)
         _check.choice(self.linear_solver, "options.linear_solver", LINEAR_SOLVERS)
         _check.choice(self.predictor, "options.predictor", ("quadratic", "secant", "tangent"))
         _check.choice(self.flat_start, "options.flat_start", ("rigid", "tangent"))

@@ -58,7 +58,6 @@ class Timer:
     n_iterations: int = 0
     n_krylov: int = 0
     n_force_only: int = 0  # evaluations without the tangent (convergence expected)
-    n_chord: int = 0  # corrections with the previous factorisation (option chord_steps)
 
     def as_dict(self) -> dict[str, float]:
         return dataclasses.asdict(self)

@@ -327,12 +327,8 @@ class _Driver:
             self._factorize_or_fail(e, new, res, reuse=n_iter > 0)
             n_iter += 1
             dx, dmu = self.system.solve(-e.r[free], -e.c, rtol=self.forcing(e, new, rf))
-            light = self._expects_convergence(res)
-            chord = o.chord_steps > 0 and not self.system.reuse and o.line_search == 0
-            new, e, alpha = self._line_search(new, e, dx, dmu, light)
+            new, e, alpha = self._line_search(new, e, dx, dmu, self._expects_convergence(res))
             dx_last = alpha * dx
-            if chord:
-                new, e, dx_last = self._chord_steps(new, e, dx_last, rf)
 
     def _guided_prediction(self, st: _State, t1: float, lam1: float) -> _State | None:
         """Rigid-fold prediction of the increment to ``t1`` (None: use the usual predictor).
@@ -549,34 +545,6 @@ class _Driver:
                 return trial, et, alpha
             alpha *= 0.5
         raise AssertionError("unreachable")
-
-    def _chord_steps(
-        self, st: _State, e: _Eval, dx: np.ndarray, rf0: float
-    ) -> tuple[_State, _Eval, np.ndarray]:
-        """Corrections with the factorisation Newton just used (chord or Shamanskii steps;
-        Kelley 2003, Solving Nonlinear Equations with Newton's Method, sec. 2.5) while the
-        force residual at ``st`` (``e``) exceeds the
-        one before the Newton step (``rf0``). Near a mechanism the Newton step moves far
-        along a soft mode and the stiff bars it stretches make the residual jump; that part
-        of the residual is linear in the stiff directions, so the previous tangent corrects
-        it without a new factorisation. A correction is kept only if it lowers the residual
-        (at most ``options.chord_steps``). Returns the state, its evaluation and the total
-        displacement correction of this iteration."""
-        free = self.free
-        rf = float(np.linalg.norm(e.r[free]))
-        for _ in range(self.opts.chord_steps):
-            if not (np.isfinite(rf) and rf > rf0):
-                break
-            ddx, ddmu = self.system.direct.solve(-e.r[free], -e.c)
-            trial = _State(st.x.copy(), st.mu + ddmu, st.lam, st.t)
-            trial.x[free] += ddx
-            et = self.evaluate(trial)  # with the tangent: the next iterate if kept
-            self.timer.n_chord += 1
-            rt = float(np.linalg.norm(et.r[free]))
-            if not (np.isfinite(rt) and rt < rf):
-                break
-            st, e, rf, dx = trial, et, rt, dx + ddx
-        return st, e, dx
 
     def _factorize_or_fail(
         self, e: _Eval, st: _State, res: list[float], reuse: bool = False
