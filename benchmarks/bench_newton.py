@@ -85,7 +85,7 @@ def main() -> None:
 
     logging.disable(logging.WARNING)  # the compliant sheet's stability events
     options = json.loads(a.options)
-    out(f"## Newton step control: Miura n x n, flat -> 60 deg in {a.steps} steps")
+    out(f"### Newton step control: Miura n x n, flat -> 60 deg in {a.steps} steps")
     if options:
         out(f"options: {options}")
     out("| " + " | ".join(COLS) + " |")
