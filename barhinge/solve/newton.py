@@ -152,6 +152,9 @@ class _Driver:
         self.exact_inertia = self.opts.exact_inertia(scene.control)
         self._inc_serial = 0  # factorisations made before the current increment
         self._arc_s = 0.0  # chord length along the arc-length path (work integration)
+        # per recorded step (state 1 on): Newton iterations of its converged increments,
+        # increments (converged, failed), factorisations (all, of them for the inertia)
+        self.step_stats: list[dict[str, int]] = []
 
     # ------------------------------------------------------------ schedules
     def targets(self, t: float) -> np.ndarray:
@@ -598,6 +601,7 @@ class _Driver:
             "timing": self.timer.as_dict(),
             "flat_start": self.flat_start_record,
             "branch_events": self.branch_events(),
+            "newton": self._newton_summary(),
         }
         meta["negative_eigenvalues"] = [r.get("neg") for r in rec]
         events = meta["branch_events"] + self._stability_events()
@@ -627,6 +631,21 @@ class _Driver:
             kind="bar-hinge",
             meta=meta,
         )
+
+    def _newton_summary(self) -> dict[str, Any]:
+        """Step control per recorded step (``FoldPath.meta["newton"]``): lists over the
+        states 1.. of Newton iterations (converged increments only), increments, failed
+        increments (redone shorter), factorisations (all) and those made to confirm the
+        tangent's inertia at the state; totals alongside. Under arc length every state is
+        one increment and only the iterations are listed."""
+        if not self.step_stats:
+            its = [int(r["iters"]) for r in self.records[1:]]
+            return {"iterations": its, "total_iterations": int(sum(its))}
+        keys = ("iterations", "increments", "failed", "factorizations", "inertia_factorizations")
+        out: dict[str, Any] = {k: [d[k] for d in self.step_stats] for k in keys}
+        for k in keys:
+            out[f"total_{k}"] = int(sum(out[k]))
+        return out
 
     def interrupted_path(self) -> FoldPath | None:
         """The converged part after a Ctrl-C (``meta["stopped"] = "interrupted"``); None
@@ -680,6 +699,8 @@ class _Driver:
         for s in range(1, steps + 1):
             t_goal = s / steps
             iters, res_all = 0, []
+            n_inc = n_failed = 0
+            fact0 = self.timer.n_factorizations
             critical = ""  # a limit-point diagnosis from any attempt since the last success
             while st.t < t_goal - 1e-12 * h0:
                 h_try = min(h, t_goal - st.t)
@@ -691,6 +712,7 @@ class _Driver:
                     log.debug(
                         "step %d: increment to t=%.6g failed (%s); cutting back", s, t1, f.why
                     )
+                    n_failed += 1
                     if f.why.startswith(self._critical):
                         critical = f.why
                     elif self.system.track_inertia and self._inertia is not None:
@@ -732,10 +754,22 @@ class _Driver:
                 self._prev2, self._prev, st = self._prev, st, new
                 self._inertia = self.system.negative_pivots
                 iters += self.n_iter_last
+                n_inc += 1
                 res_all.extend(res)
                 if self.n_iter_last <= o.grow_iters:
                     h = min(2 * h_try, h0)
-            self.record(st, e_new, iters, res_all, neg=self._state_inertia(st, e_new))
+            fact1 = self.timer.n_factorizations
+            neg = self._state_inertia(st, e_new)
+            self.step_stats.append(
+                {
+                    "iterations": iters,
+                    "increments": n_inc,
+                    "failed": n_failed,
+                    "factorizations": self.timer.n_factorizations - fact0,
+                    "inertia_factorizations": self.timer.n_factorizations - fact1,
+                }
+            )
+            self.record(st, e_new, iters, res_all, neg=neg)
             if progress is not None:
                 progress(s, steps, st.t)
         return self.path()

@@ -1,0 +1,146 @@
+"""Newton step control: iterations and factorisations per step, both stiffness sets.
+
+Run:  python benchmarks/bench_newton.py [--sizes 10 20] [--steps 50] [--repeat 1]
+      [--options '{"predictor": "secant"}'] [--publish]
+
+``--publish`` also writes the tables into docs/solver-performance.md (between the
+``bench_newton`` markers).
+
+Miura n x n cells folded by actuators on the middle crease line from flat to 60 deg in
+``--steps`` steps (``bench_solver.miura_scene``), for the quasi-rigid and the compliant
+stiffness sets (``bench_solver._stiffness_model``). Per run: DOF, Newton iterations (of the
+converged increments), increments that failed and were redone shorter, factorisations (all,
+per step, in step 1, to confirm the tangent's inertia), the largest iteration count of a
+step, wall and CPU time (medians over ``--repeat``), and per size the ratio compliant /
+quasi-rigid of factorisations and wall time (issue 19 asks for at most 2). The figures come
+from ``FoldPath.meta["newton"]`` and ``meta["timing"]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import barhinge as bh
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_solver import miura_scene  # noqa: E402
+
+COLS = (
+    "n",
+    "material",
+    "DOF",
+    "iterations",
+    "failed incr.",
+    "factorisations",
+    "fact./step",
+    "fact. step 1",
+    "inertia fact.",
+    "max iter./step",
+    "wall s",
+    "CPU s",
+)
+
+
+def run(n: int, material: str, steps: int, options: dict) -> dict:
+    """One solve; the figures of one table row."""
+    sc = miura_scene(n, 0.0, steps, material=material)
+    if options:
+        sc = sc.with_(options={**sc.options.__dict__, **options})
+    c0, t0 = time.process_time(), time.perf_counter()
+    path = bh.solve(sc)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    nw = path.meta["newton"]
+    return {
+        "dof": sc.model.n_dof,
+        "iterations": nw["total_iterations"],
+        "failed": nw["total_failed"],
+        "fact": path.meta["timing"]["n_factorizations"],
+        "fact1": nw["factorizations"][0],
+        "inertia": nw["total_inertia_factorizations"],
+        "max_iter": max(nw["iterations"]),
+        "wall": wall,
+        "cpu": cpu,
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--sizes", type=int, nargs="*", default=[10, 20])
+    ap.add_argument("--steps", type=int, default=50)
+    ap.add_argument("--repeat", type=int, default=1)
+    ap.add_argument("--options", default="{}", help="solver options (JSON) for every run")
+    ap.add_argument("--publish", action="store_true", help="write into docs/")
+    a = ap.parse_args()
+    lines: list[str] = []
+
+    def out(line: str = "") -> None:
+        print(line, flush=True)
+        lines.append(line)
+
+    logging.disable(logging.WARNING)  # the compliant sheet's stability events
+    options = json.loads(a.options)
+    out(f"### Newton step control: Miura n x n, flat -> 60 deg in {a.steps} steps")
+    if options:
+        out(f"options: {options}")
+    out("| " + " | ".join(COLS) + " |")
+    out("|" + "---|" * len(COLS))
+    ratios = []
+    for n in a.sizes:
+        rows = {}
+        for material in ("quasi-rigid", "compliant"):
+            runs = [run(n, material, a.steps, options) for _ in range(a.repeat)]
+            r = dict(runs[-1])
+            r["wall"] = statistics.median(x["wall"] for x in runs)
+            r["cpu"] = statistics.median(x["cpu"] for x in runs)
+            rows[material] = r
+            row = (
+                n,
+                material,
+                r["dof"],
+                r["iterations"],
+                r["failed"],
+                r["fact"],
+                f"{r['fact'] / a.steps:.1f}",
+                r["fact1"],
+                r["inertia"],
+                r["max_iter"],
+                f"{r['wall']:.2f}",
+                f"{r['cpu']:.2f}",
+            )
+            out("| " + " | ".join(str(v) for v in row) + " |")
+        q, c = rows["quasi-rigid"], rows["compliant"]
+        ratios.append((n, c["fact"] / q["fact"], c["wall"] / q["wall"]))
+    out()
+    out("| n | factorisations compliant / quasi-rigid | wall compliant / quasi-rigid |")
+    out("|---|---|---|")
+    for n, rf, rw in ratios:
+        out(f"| {n} | {rf:.2f} | {rw:.2f} |")
+    if a.publish:
+        publish(lines, a)
+
+
+def publish(lines: list[str], a: argparse.Namespace) -> None:
+    """Replace the text between the markers in docs/solver-performance.md."""
+    doc = Path(__file__).resolve().parents[1] / "docs" / "solver-performance.md"
+    text = doc.read_text()
+    start, end = "<!-- bench_newton:start -->", "<!-- bench_newton:end -->"
+    cmd = "python benchmarks/bench_newton.py --publish"
+    if a.options != "{}":
+        cmd += f" --options '{a.options}'"
+    body = "\n".join([start, f"Written by `{cmd}` (this machine).", "", *lines, end])
+    if start in text and end in text:
+        head, rest = text.split(start, 1)
+        text = head + body + rest.split(end, 1)[1]
+    else:
+        text = text.rstrip("\n") + "\n\n" + body + "\n"
+    doc.write_text(text)
+
+
+if __name__ == "__main__":
+    main()
