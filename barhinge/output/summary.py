@@ -85,6 +85,9 @@ def run_summary(path: FoldPath, scene: Any = None) -> dict[str, Any]:
             "moment": [_finite(m) for m in moments[last].tolist()],
         },
         "timing": path.meta.get("timing", {}),
+        # step control per step: Newton iterations, increments, failed increments,
+        # factorisations (bar-and-hinge runs; docs/solver-performance.md)
+        "newton": path.meta.get("newton"),
         # stability events (limit points, bifurcations, negative-stiffness branches) and
         # the work balance; see docs/solver.md
         "events": [str(e) for e in path.meta.get("events", [])],
@@ -136,6 +139,16 @@ def summary_rows(summary: dict[str, Any], path: FoldPath | None = None) -> list[
     rows.append(("states", str(summary["n_states"])))
     if summary["model"] != "rigid":
         rows.append(("Newton iterations", str(summary["newton_iterations"])))
+        nw = summary.get("newton") or {}
+        if nw.get("total_factorizations") is not None:
+            steps = max(len(nw.get("factorizations") or []), 1)
+            rows.append(
+                (
+                    "factorisations (per step; failed increments)",
+                    f"{nw['total_factorizations']} ({nw['total_factorizations'] / steps:.1f}; "
+                    f"{nw.get('total_failed', 0)})",
+                )
+            )
     if summary["wall_time_s"] is not None:
         rows.append(("wall time (s)", f"{summary['wall_time_s']:.2f}"))
     if summary.get("linear_solver"):

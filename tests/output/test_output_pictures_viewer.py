@@ -134,3 +134,15 @@ def test_unloaded_scene_has_no_buckling_record(solved, tmp_path):
     scene, path = solved
     run = write_run(path, scene, tmp_path / "out", pictures="none", viewer=False)
     assert "buckling" not in run.summary["results"]
+
+
+def test_summary_reports_factorisations_per_step(solved, tmp_path):
+    """The step-control record of the solver (counted independently in
+    tests/solve/test_newton_stats.py) reaches summary.json and the printed table."""
+    scene, path = solved
+    run = write_run(path, scene, tmp_path / "out", pictures="none", viewer=False)
+    nw = run.summary["newton"]
+    assert nw["iterations"] == [int(i) for i in path.iterations[1:]]
+    assert nw["total_factorizations"] == sum(nw["factorizations"]) >= len(nw["factorizations"])
+    row = dict(summary_rows(run.summary))["factorisations (per step; failed increments)"]
+    assert row.startswith(f"{nw['total_factorizations']} (")
