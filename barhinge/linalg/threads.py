@@ -120,23 +120,21 @@ def sparse_solves() -> Iterator[None]:
         yield
 
 
-def single_threaded_dense(fn: F) -> F:
-    """Decorator: run ``fn`` inside :func:`dense_calls`."""
+def _within(context: Callable[[], contextlib.AbstractContextManager[None]]):
+    """A decorator running its function inside ``context()``."""
 
-    @functools.wraps(fn)
-    def wrapper(*args: Any, **kwargs: Any) -> Any:
-        with dense_calls():
-            return fn(*args, **kwargs)
+    def decorate(fn: F) -> F:
+        @functools.wraps(fn)
+        def wrapper(*args: Any, **kwargs: Any) -> Any:
+            with context():
+                return fn(*args, **kwargs)
 
-    return wrapper  # type: ignore[return-value]
+        return wrapper  # type: ignore[return-value]
+
+    return decorate
 
 
-def threads_for_sparse(fn: F) -> F:
-    """Decorator: run ``fn`` inside :func:`sparse_solves`."""
-
-    @functools.wraps(fn)
-    def wrapper(*args: Any, **kwargs: Any) -> Any:
-        with sparse_solves():
-            return fn(*args, **kwargs)
-
-    return wrapper  # type: ignore[return-value]
+#: decorator: run the function inside :func:`dense_calls`
+single_threaded_dense = _within(dense_calls)
+#: decorator: run the function inside :func:`sparse_solves`
+threads_for_sparse = _within(sparse_solves)
