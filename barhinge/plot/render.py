@@ -420,7 +420,8 @@ def _bounds(Xs: np.ndarray) -> tuple[float, ...]:
 
 
 # ------------------------------------------------------------------------- matplotlib
-def _render_mpl(d, where, name, values, cmap, clim, path, window_size, view, title, label=None):
+def _render_mpl(d, where, name, values, cmap, clim, path, window_size, view, title, label=None,
+                fixed=None, loads=None):  # fmt: skip
     import matplotlib
 
     matplotlib.use("Agg")
@@ -455,6 +456,11 @@ def _render_mpl(d, where, name, values, cmap, clim, path, window_size, view, tit
     else:
         lc, lw = EDGE, 0.8
     ax.add_collection3d(Line3DCollection(seg, colors=lc, linewidths=lw))
+    sup, at, vec = _supports_and_loads(P, fixed, loads)
+    if len(sup):
+        ax.scatter(*sup.T, color="black", s=18, depthshade=False)
+    if len(at):
+        ax.quiver(*at.T, *vec.T, color="#8e44ad", linewidth=1.5)
     b = np.array(_bounds(P[None])).reshape(3, 2)
     ax.set_box_aspect(np.maximum(b[:, 1] - b[:, 0], 1e-3 * np.ptp(b)))
     for setlim, (lo, hi) in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), b, strict=True):
@@ -476,26 +482,47 @@ def _render_mpl(d, where, name, values, cmap, clim, path, window_size, view, tit
         )
     if title:
         ax.set_title(title)
+    fig.text(0.99, 0.01, extent_text(P), ha="right", va="bottom", fontsize=8, color="#555555")
     fig.savefig(path, dpi=dpi, facecolor="white", bbox_inches="tight")
     plt.close(fig)
     return path
+
+
+def extent_text(X: np.ndarray) -> str:
+    """The scale of a picture in words: the extent of the state along x, y and z (in the
+    pattern's length unit), e.g. ``"extent x 12 × y 8.5 × z 3.1"``."""
+    dx, dy, dz = np.ptp(np.asarray(X, float).reshape(-1, 3), axis=0)
+    return f"extent x {dx:.3g} × y {dy:.3g} × z {dz:.3g}"
+
+
+def _supports_and_loads(
+    X: np.ndarray, fixed: np.ndarray | None, loads: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(supported points (m, 3), loaded points (k, 3), their load vectors scaled so the
+    largest is 8 % of the state's size (k, 3))."""
+    size = float(np.linalg.norm(np.ptp(X, axis=0))) or 1.0
+    sup = np.zeros((0, 3))
+    if fixed is not None:
+        sup = X[np.asarray(fixed, bool).reshape(-1, 3)[: len(X)].any(axis=1)]
+    at, vec = np.zeros((0, 3)), np.zeros((0, 3))
+    if loads is not None:
+        F = np.asarray(loads, float).reshape(-1, 3)[: len(X)]
+        mag = np.linalg.norm(F, axis=1)
+        on = mag > 0
+        if on.any():
+            at, vec = X[on], F[on] * (0.08 * size / mag.max())
+    return sup, at, vec
 
 
 def _add_supports_and_loads(
     p, X: np.ndarray, fixed: np.ndarray | None, loads: np.ndarray | None
 ) -> None:
     """Black dots at the supported nodes, purple arrows along the loads."""
-    size = float(np.linalg.norm(np.ptp(X, axis=0))) or 1.0
-    if fixed is not None:
-        f = np.asarray(fixed, bool).reshape(-1, 3)[: len(X)].any(axis=1)
-        if f.any():
-            p.add_points(X[f], color="black", point_size=12, render_points_as_spheres=True)
-    if loads is not None:
-        F = np.asarray(loads, float).reshape(-1, 3)[: len(X)]
-        mag = np.linalg.norm(F, axis=1)
-        on = mag > 0
-        if on.any():
-            p.add_arrows(X[on], F[on], mag=0.08 * size / mag.max(), color="#8e44ad")
+    sup, at, vec = _supports_and_loads(X, fixed, loads)
+    if len(sup):
+        p.add_points(sup, color="black", point_size=12, render_points_as_spheres=True)
+    if len(at):
+        p.add_arrows(at, vec, mag=1.0, color="#8e44ad")
 
 
 # ------------------------------------------------------------------------------ API
@@ -540,10 +567,12 @@ def render_state(
         Title of the picture; title of the colour bar (default: the array's name and unit).
     backend : {"auto", "pyvista", "matplotlib"}
     fixed : (n_nodes, 3) bool, optional
-        Supports: nodes with a fixed DOF are drawn as black dots (pyvista backend).
+        Supports: nodes with a fixed DOF are drawn as black dots.
     loads : (n_nodes, 3) float, optional
-        Loads: purple arrows at the loaded nodes, the largest 8 % of the state's size long
-        (pyvista backend).
+        Loads: purple arrows at the loaded nodes, the largest 8 % of the state's size long.
+
+    Every picture states its scale: the extent of the state along x, y and z, in the
+    pattern's length unit (lower right).
     """
     path = Path(path)
     d = state_data(
@@ -555,7 +584,8 @@ def render_state(
     where, name, values = _pick(d, scalars)
     lim = _clim(name, values, clim)
     if _backend(backend) == "matplotlib":
-        return _render_mpl(d, where, name, values, cmap, lim, path, window_size, view, title, label)
+        return _render_mpl(d, where, name, values, cmap, lim, path, window_size, view, title,
+                           label, fixed=fixed, loads=loads)  # fmt: skip
     p = _plotter(window_size)
     try:
         meshes = _polydata(d)
@@ -567,6 +597,7 @@ def render_state(
         _scalar_bar(p, bar)
         if title:
             p.add_text(title, position="upper_left", font_size=14, color="black")
+        p.add_text(extent_text(d.points), position="lower_right", font_size=9, color="#555555")
         p.screenshot(str(path))
     finally:
         p.close()
