@@ -40,7 +40,6 @@ from typing import Literal
 
 import numpy as np
 from scipy.interpolate import CubicSpline
-from scipy.optimize import brentq
 
 from barhinge import _check
 from barhinge.actuators import Actuators
@@ -229,6 +228,8 @@ def _next_parameter(curve: ControlCurve, u0: float, P0: np.ndarray, d: float, si
         hi = u0 + sign * k * h
         if g(hi) >= 0.0:
             a, b = sorted((lo, hi))
+            from scipy.optimize import brentq  # lazy: scipy.optimize costs ~0.15 s to import
+
             return float(brentq(g, a, b, xtol=1e-15 * max(1.0, abs(u0) + d), rtol=1e-15))
         lo = hi
     raise ConfigError(

@@ -27,7 +27,6 @@ import dataclasses
 from typing import Any
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from barhinge.errors import ConfigError
 
@@ -182,6 +181,8 @@ def local_curvatures(
     m = len(P)
     if m < 6:
         raise ConfigError(f"curvature needs at least 6 reference points, got {m}")
+    from scipy.spatial import cKDTree  # lazy: scipy.spatial costs ~0.25 s to import
+
     tree = cKDTree(P)
     if radius is None:
         dist, _ = tree.query(P, k=2)
@@ -359,6 +360,7 @@ def gaussian_curvature(
     model: Any | None = None,
     triangles: np.ndarray | None = None,
     radius: float | None = None,
+    local: bool = True,
 ) -> Curvature:
     """Curvature of the global form and angle defects of one state.
 
@@ -380,6 +382,9 @@ def gaussian_curvature(
         Triangulation of the nodes for the angle defect (overrides the above).
     radius : float, optional
         Neighbourhood radius of the local fits (default 2.5 x median spacing).
+    local : bool
+        Also fit the local quadratics (``k1``, ``k2``, ``K``, ``H``, ``normals``); False
+        leaves them empty (``radius`` NaN) when only the global form is wanted.
     """
     from barhinge.results import FoldPath
 
@@ -405,7 +410,12 @@ def gaussian_curvature(
     else:
         pts = np.asarray(points)
         P = X[pts.astype(np.int64)] if pts.ndim == 1 else pts.astype(float)
-    local = local_curvatures(P, radius=radius)
+    if local:
+        fits = local_curvatures(P, radius=radius)
+    else:
+        empty = np.zeros(0)
+        fits = {"k1": empty, "k2": empty, "K": empty, "H": empty,
+                "normals": np.zeros((0, 3)), "radius": np.nan}  # fmt: skip
     glob = fit_quadratic(P)
     defect = area = None
     if triangles is not None:
@@ -416,12 +426,12 @@ def gaussian_curvature(
         area = mixed_voronoi_area(X, T)
     return Curvature(
         points=P,
-        k1=local["k1"],
-        k2=local["k2"],
-        K=local["K"],
-        H=local["H"],
-        normals=local["normals"],
-        radius=float(local["radius"]),
+        k1=fits["k1"],
+        k2=fits["k2"],
+        K=fits["K"],
+        H=fits["H"],
+        normals=fits["normals"],
+        radius=float(fits["radius"]),
         global_fit=glob,
         angle_defect=defect,
         vertex_area=area,

@@ -63,7 +63,7 @@ def summarize(
     }
     if cp is not None and cp.n_faces >= 6:
         try:
-            c = gaussian_curvature(X, pattern=cp, model=model)
+            c = gaussian_curvature(X, pattern=cp, model=model, local=False)
         except BarhingeError as exc:  # degenerate reference points
             log.info("no curvature: %s", exc)
         else:

@@ -36,7 +36,6 @@ from __future__ import annotations
 import logging
 
 import numpy as np
-from scipy.optimize import lsq_linear
 
 from barhinge.errors import ConfigError
 from barhinge.model.material import Material
@@ -199,6 +198,8 @@ def _bounded_fits(G: np.ndarray, y: np.ndarray, a_min: np.ndarray) -> np.ndarray
             ng += 1
         Gt = np.zeros((Gf.shape[0], ng))
         np.add.at(Gt.T, group, Gf.T)
+        from scipy.optimize import lsq_linear  # lazy: scipy.optimize costs ~0.15 s to import
+
         res = lsq_linear(Gt, y[f], bounds=(a_min[f], np.inf))
         out[u] = res.x[group]
     return out[inv.ravel()]
