@@ -381,6 +381,56 @@ def analyse(family: str, state: float, scheme: str = "N5B8", **override) -> dict
     }
 
 
+def stability(
+    family: str, state: float, scheme: str = "N5B8", steps: int = 10, **override
+) -> dict[str, Any]:
+    """Stability of one roof under the design load (uniform load plus self-weight).
+
+    ``buckling_factor``: the first linear buckling factor of the stress-free folded state
+    (:func:`barhinge.analysis.buckling.linear_buckling`; NaN when there is none).
+    ``limit_load_factor``: the nonlinear check, arc length (MGDCM) from the unloaded state
+    that stops at the design load (load factor 1) or at the first limit point, whichever
+    comes first; the load factor of that limit point, or None when the roof carries the
+    design load without one. ``deflection_nonlinear``: the largest deflection at the end of
+    that path (at load factor 1 when it is reached), m. ``instability_load_factor``: the
+    lowest load factor on that path at which the roof is no longer stable, a limit point or
+    the first state whose tangent has a negative eigenvalue (a bifurcation), or None.
+    ``events``: the solver's stability events on the path."""
+    import barhinge as bh
+    from barhinge.analysis.buckling import linear_buckling
+    from barhinge.errors import BarhingeError
+    from barhinge.scene import Scene, self_weight
+
+    cp, flat_xy, crease = folded(family, state, **override)
+    model = bh.BarHingeModel.from_pattern(cp, scheme, material())
+    if "F" in set(np.asarray(cp.assignment)):
+        model = flat_line_stiffness(model, crease)
+    S = supports(model, flat_xy, FAMILIES[family]["axis"])
+    P = plan_load(model, Q) + self_weight(model, DENSITY * MATERIAL["t"], g=(0.0, 0.0, -G))
+    try:
+        lam_b = float(linear_buckling(model, P, S, n_modes=1).factors[0])
+    except BarhingeError:
+        lam_b = float("nan")
+    scene = Scene(model, supports=S, loads=P, control="arc_length", steps=steps,
+                  options={"arc_stop_load_factor": 1.0, "arc_stop_limit_points": 1,
+                           "max_arc_steps": 40 * steps})  # fmt: skip
+    path = bh.solve(scene)
+    stop = path.meta["arc_stop"]["criterion"]
+    lam = np.asarray(path.load_factor)
+    U = np.asarray(path.X[-1]) - np.asarray(path.X[0])
+    neg = [n for n in path.meta["negative_eigenvalues"]]
+    first_neg = next((k for k, n in enumerate(neg) if n is not None and n > 0), None)
+    limit = float(lam.max()) if stop == "limit_points" else None
+    unstable = [v for v in (limit, None if first_neg is None else float(lam[first_neg])) if v]
+    return {
+        "buckling_factor": lam_b,
+        "limit_load_factor": limit,
+        "instability_load_factor": min(unstable) if unstable else None,
+        "deflection_nonlinear": float(np.max(-U[:, 2])),
+        "events": list(path.meta.get("events", [])),
+    }
+
+
 # ------------------------------------------------------------------------------ beam check
 def corrugated_beam(n: int, w: float, fold: float, L: float) -> dict[str, float]:
     """Classical estimate for the corrugation as a beam clamped at both ends (all end-section

@@ -11,8 +11,14 @@ Geometry, loads and the analysis: ``roofs.py``. Results at module level: ``RESUL
 dicts, one per family and fold state), ``FAILED`` (family, state, reason), ``BEAM`` (list of
 beam-check dicts), ``PLATE`` (flat-sheet checks).
 
-Run: ``python studies/roofs/run.py [--quick]``; full mode writes docs/roofs.csv,
-docs/img/roofs.png and prints the markdown table of docs/roofs.md. Importing the module runs
+Every roof also gets its stability under the design load (``roofs.stability``): the linear
+buckling factor and an arc-length path that stops at load factor 1 or at the first limit
+point, with the load factor where the roof stops being stable (a limit point or a
+bifurcation); the ranking states it.
+
+Run: ``python studies/roofs/run.py [--quick] [--publish]``; full mode writes docs/roofs.csv,
+docs/img/roofs.png and prints the results table and the ranking (``--publish`` also writes
+them into docs/roofs.md). Importing the module runs
 the quick mode (a few states per family).
 """
 
@@ -64,6 +70,14 @@ def run() -> tuple[list[dict], list[tuple], list[dict]]:
             except (BarhingeError, np.linalg.LinAlgError, ArithmeticError) as exc:
                 failed.append((fam, st, f"{type(exc).__name__}: {str(exc).splitlines()[0]}"))
                 continue
+            try:
+                st_rec = roofs.stability(fam, st)
+            except BarhingeError as exc:  # the nonlinear check failed: say so in the table
+                why = f"nonlinear check failed: {str(exc).splitlines()[0]}"
+                st_rec = {"buckling_factor": float("nan"), "limit_load_factor": None,
+                          "instability_load_factor": None, "deflection_nonlinear": float("nan"),
+                          "events": [why]}  # fmt: skip
+            rec.update(st_rec)
             rec["time_s"] = time.perf_counter() - t0
             results.append(rec)
     beam = [roofs.pleat_beam_check(f, n) for f in BEAM_FOLDS for n in BEAM_STRIPS]
@@ -91,6 +105,9 @@ COLUMNS = (
     "stiffness_per_sheet_area",
     "peak_strain",
     "equilibrium_error",
+    "buckling_factor",
+    "instability_load_factor",
+    "deflection_nonlinear",
     "time_s",
 )
 
@@ -100,7 +117,19 @@ def write_csv(path: Path) -> None:
         w = csv.writer(fh)
         w.writerow(COLUMNS)
         for r in RESULTS:
-            w.writerow([f"{r[c]:.6g}" if isinstance(r[c], float) else r[c] for c in COLUMNS])
+            w.writerow([f"{r[c]:.6g}" if isinstance(r[c], float) else
+                        ("" if r[c] is None else r[c]) for c in COLUMNS])  # fmt: skip
+
+
+def stable(r: dict) -> bool:
+    """Carries the design load (load factor 1) without a limit point or bifurcation, and its
+    linear buckling factor is above 1."""
+    lam_b = r["buckling_factor"]
+    return r["instability_load_factor"] is None and not (np.isfinite(lam_b) and lam_b <= 1.0)
+
+
+def _lam(v) -> str:
+    return "—" if v is None or not np.isfinite(v) else f"{v:.3f}"
 
 
 def table() -> str:
@@ -108,8 +137,10 @@ def table() -> str:
     lines = [
         "| family | state | mean fold (deg) | width (m) | depth (m) | sheet / plan area | "
         "mean / max deflection, q (mm) | max deflection, self-weight (mm) | "
-        "k / width (kN/m/m) | k / sheet area (kN/m/m^2) | peak bar strain |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "k / width (kN/m/m) | k / sheet area (kN/m/m^2) | peak bar strain | "
+        "linear buckling factor | nonlinear: unstable at load factor | "
+        "nonlinear max deflection (mm) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in RESULTS:
         lines.append(
@@ -118,10 +149,39 @@ def table() -> str:
             f"{1e3 * r['mean_deflection_q']:.2f} / {1e3 * r['deflection_q']:.1f} | "
             f"{1e3 * r['deflection_sw']:.2f} | "
             f"{r['stiffness_per_width'] / 1e3:.1f} | {r['stiffness_per_sheet_area'] / 1e3:.2f} | "
-            f"{r['peak_strain']:.1e} |"
+            f"{r['peak_strain']:.1e} | {_lam(r['buckling_factor'])} | "
+            f"{_lam(r['instability_load_factor'])} | {1e3 * r['deflection_nonlinear']:.2f} |"
         )
     for fam, st, why in FAILED:
-        lines.append(f"| {fam} | {st:g} | failed: {why} |" + " |" * 8)
+        lines.append(f"| {fam} | {st:g} | failed: {why} |" + " |" * 11)
+    return "\n".join(lines)
+
+
+def ranking(top: int = 6) -> str:
+    """The roofs ranked by stiffness per unit width, stability stated: those that carry the
+    design load first, then those that do not, with the load factor where they stop being
+    stable."""
+    ok = sorted((r for r in RESULTS if stable(r)), key=lambda r: -r["stiffness_per_width"])
+    bad = sorted((r for r in RESULTS if not stable(r)), key=lambda r: -r["stiffness_per_width"])
+    lines = ["Stiffest roofs that carry the design load (no limit point or bifurcation below "
+             "load factor 1, linear buckling factor above 1):", ""]  # fmt: skip
+    for i, r in enumerate(ok[:top], 1):
+        lines.append(
+            f"{i}. {r['family']} {r['state']:g}: k / width {r['stiffness_per_width'] / 1e3:.1f} "
+            f"kN/m/m, linear buckling factor {_lam(r['buckling_factor'])}"
+        )
+    lines += ["", "Roofs that are not stable up to the design load (ranked by linear "
+              "stiffness, which does not apply to them beyond that load factor):", ""]  # fmt: skip
+    for r in bad:
+        lam_b, lam_i = r["buckling_factor"], r["instability_load_factor"]
+        what = (f"unstable at load factor {lam_i:.3f} on the nonlinear path"
+                if lam_i is not None else "nonlinear path stable to 1")  # fmt: skip
+        lines.append(
+            f"- {r['family']} {r['state']:g}: k / width {r['stiffness_per_width'] / 1e3:.1f} "
+            f"kN/m/m; {what}; linear buckling factor {_lam(lam_b)}"
+        )
+    if not bad:
+        lines.append("- none")
     return "\n".join(lines)
 
 
@@ -206,7 +266,17 @@ if MAIN:
         csv_path, png_path = ROOT / "docs" / "roofs.csv", ROOT / "docs" / "img" / "roofs.png"
     write_csv(csv_path)
     chart(png_path)
+    if "--publish" in sys.argv and not QUICK:
+        doc = ROOT / "docs" / "roofs.md"
+        text = doc.read_text(encoding="utf-8")
+        start, end = "<!-- roofs:start -->", "<!-- roofs:end -->"
+        i, j = text.index(start) + len(start), text.index(end)
+        doc.write_text(text[:i] + "\n" + table() + "\n\n" + ranking() + "\n" + text[j:],
+                       encoding="utf-8")  # fmt: skip
+        print(f"wrote the results table and ranking into {doc}")
     print(table())
+    print()
+    print(ranking())
     print()
     print(beam_table())
     print()
