@@ -3,7 +3,8 @@ of JᵀJ − τ²I and null space), local and region DOF (batched SVDs), the act
 (pivoted QR) and the search for a folded state nearby.
 
 Usage: python benchmarks/bench_dof.py [--sizes 10 20 35 50 70] [--repeat 3] [--no-files]
-       [--families miura yoshimura eggbox] [--max-yoshimura 30] [--publish]
+       [--families miura yoshimura eggbox] [--max-yoshimura 70]
+       [--yoshimura-sizes 10 20 40 115] [--publish]
 
 ``--publish`` writes the table and the fitted exponents into docs/kinematics.md between the
 ``dof-scale:start`` / ``dof-scale:end`` markers.
@@ -105,6 +106,7 @@ def main() -> None:
     ap.add_argument(
         "--max-yoshimura", type=int, default=70, help="largest Yoshimura n (cells per side)"
     )
+    ap.add_argument("--yoshimura-sizes", type=int, nargs="+", help="Yoshimura n (default: --sizes)")
     ap.add_argument("--publish", action="store_true", help="rewrite docs/kinematics.md")
     a = ap.parse_args()
     emit(
@@ -116,7 +118,8 @@ def main() -> None:
     fits = {}
     for fam in a.families:
         xs, ts, ps = [], [], defaultdict(list)
-        for n in a.sizes:
+        sizes = a.yoshimura_sizes if fam == "yoshimura" and a.yoshimura_sizes else a.sizes
+        for n in sizes:
             if fam == "yoshimura" and n > a.max_yoshimura:
                 continue  # flat Yoshimura: a first-order null space of ~creases / 3
             rep, t, per = row(f"{fam} {n} x {n}", FAMILY[fam](n), a.repeat)
