@@ -48,6 +48,10 @@ FLAT_TOL = 1e-6
 #: up to this many columns a Gauss-Newton step of the folded-state search is a dense
 #: least-squares solve; above, one sparse factorisation of the damped normal matrix
 STEP_DENSE_LIMIT = DENSE_LIMIT
+#: at a flat state whose first-order null space is wider than this, the null vectors are not
+#: formed (n_var x nullity² flops): rank and gap from the inertia, no actuators (the folded
+#: state nearby, whose null space is small, gives them)
+FLAT_BASIS_LIMIT = 512
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -351,14 +355,14 @@ def _report(
 ) -> DofReport:
     tick(f"rank of the {rc.n_var}-crease Jacobian")
     r, J = system(rc, rho)
-    ns = null_space(J, tol)
+    flat = bool(np.max(np.abs(rho), initial=0.0) < FLAT_TOL)
+    ns = null_space(J, tol, basis_limit=FLAT_BASIS_LIMIT if flat else None)
     n_faces_extra = 0 if rc.triangulated else sum(len(f) - 3 for f in rc.pattern.faces)
     e_in_tri = rc.n_var + n_faces_extra
     n_holes = hole_loops(rc).n_holes
     counted = e_in_tri - 3 * len(rc.vertices) - 6 * n_holes - n_faces_extra
     g = rc.n_var - ns.rank
     closure = float(closure_errors(rc, rho).max(initial=0.0))
-    flat = bool(np.max(np.abs(rho), initial=0.0) < FLAT_TOL)
     try:  # a failing library (an SVD or QR that does not converge) is a named error
         tick("local and region DOF")
         local, region = local_dof(rc, rho, tol=tol)
@@ -381,7 +385,13 @@ def _report(
             f"uncertain rank: gap ratio {ns.gap_ratio:.1e} < 1e3 at the cut (σ {ns.sigma_below:.2e}"
             f" counted zero, {ns.sigma_gap:.2e} non-zero); the DOF is between {lo} and {hi}",
         )
-    if len(acts) < g:
+    if ns.basis is None:
+        note = _join(
+            note,
+            f"no actuators chosen at this flat state: its first-order null space has {g} "
+            "vectors (a bifurcation point); the folded state nearby, when found, gives them",
+        )
+    elif len(acts) < g:
         note = _join(
             note,
             f"only {len(acts)} of {g} DOF can be driven by pattern creases "
@@ -546,7 +556,8 @@ def select_actuators(
 
     Column-pivoted QR of the weighted null-space basis ``(N * w).T``: the k pivots have an
     invertible, well conditioned ``N[A, :]``, so fixing their increments fixes the whole first
-    order motion. Panel diagonals (triangulated mode) are never chosen.
+    order motion. Panel diagonals (triangulated mode) are never chosen. None are chosen when
+    the null space was not formed (``ns.basis`` is None).
 
     Parameters
     ----------
@@ -554,8 +565,7 @@ def select_actuators(
         See :func:`dof`.
     """
     N = ns.basis
-    k = N.shape[1]
-    if k == 0:
+    if N is None or N.shape[1] == 0:
         return np.zeros(0, dtype=np.int64)
     src = rc.var_source_edge
     w = np.ones(rc.n_var)

@@ -63,7 +63,9 @@ class NullSpace:
     Attributes
     ----------
     rank : int
-    basis : (n, n - rank) float, orthonormal columns spanning the null space.
+    basis : (n, n - rank) float or None
+        Orthonormal columns spanning the null space; None when the nullity exceeded the
+        ``basis_limit`` asked of :func:`null_space` (rank and gap from the inertia alone).
     tolerance : float, absolute threshold on singular values (the cut).
     sigma_max : float, largest singular value (estimate for the sparse method).
     sigma_gap : float, smallest singular value counted as non-zero (nan if none).
@@ -84,7 +86,7 @@ class NullSpace:
     """
 
     rank: int
-    basis: np.ndarray
+    basis: np.ndarray | None
     tolerance: float
     sigma_max: float
     sigma_gap: float
@@ -102,6 +104,7 @@ def null_space(
     *,
     dense_limit: int = DENSE_LIMIT,
     gap_certain: float = GAP_CERTAIN,
+    basis_limit: int | None = None,
 ) -> NullSpace:
     """Rank and null space of ``J`` (m, n), with the gap at the cut.
 
@@ -109,6 +112,11 @@ def null_space(
     ``tol`` (relative to sigma_max; default ``DENSE_TOL`` = 1e-8). Large sparse matrices: the
     nullity from the inertia of ``JᵀJ − τ²I`` (τ = ``tol`` sigma_max, default ``SPARSE_TOL``
     = 1e-6) and the null space by shift-invert subspace iteration on that factorisation.
+
+    ``basis_limit``: when the sparse method counts more null vectors than this, the basis is
+    not computed (``basis`` is None; forming it costs n x nullity² flops): the singular value
+    above the cut comes from the inertia at shifts bisected between τ and sigma_max, those
+    below it from a small shift-invert block. An uncertain cut still computes the basis.
 
     Raises
     ------
@@ -121,7 +129,7 @@ def null_space(
     try:
         if n <= dense_limit or m == 0:
             return _dense(J, tol, gap_certain)
-        return _sparse(sp.csr_matrix(J), tol, gap_certain)
+        return _sparse(sp.csr_matrix(J), tol, gap_certain, basis_limit)
     except RankError:
         raise
     except (np.linalg.LinAlgError, RuntimeError, ValueError, MemoryError) as exc:
@@ -233,7 +241,9 @@ def _backend(name: str):
     return BACKENDS[name][1]()
 
 
-def _sparse(J: sp.csr_matrix, tol: float | None, gap_certain: float) -> NullSpace:
+def _sparse(
+    J: sp.csr_matrix, tol: float | None, gap_certain: float, basis_limit: int | None = None
+) -> NullSpace:
     m, n = J.shape
     N = (J.T @ J).tocsr()
     smax = _sigma_max(N)
@@ -249,6 +259,10 @@ def _sparse(J: sp.csr_matrix, tol: float | None, gap_certain: float) -> NullSpac
     nz = inert.neg
     if nz >= n:
         raise RankError(f"the inertia says all {n} singular values are below the cut")
+    if basis_limit is not None and nz > basis_limit:
+        ns = _count_only(J, N, inert, nz, smax, atol, gap_certain)
+        if ns is not None:
+            return ns
     b = min(n, nz + _EXTRA)
     rng = np.random.default_rng(1)
     X = rng.standard_normal((n, b))
@@ -303,3 +317,55 @@ def _sparse(J: sp.csr_matrix, tol: float | None, gap_certain: float) -> NullSpac
     )  # fmt: skip
     return NullSpace(n - nz, basis, atol, smax, gap, "sparse-inertia", below, ratio, certain,
                      cand, sig)  # fmt: skip
+
+
+def _count_at(N: sp.csr_matrix, s: float) -> int:
+    """Number of singular values of J below ``s`` (inertia of ``JᵀJ − s²I``)."""
+    A = (N - s * s * sp.identity(N.shape[0], format="csr")).tocsr()
+    A.sort_indices()
+    return int(_Inertia(A).neg or 0)  # _Inertia raises when no inertia is reported
+
+
+def _count_only(
+    J: sp.csr_matrix,
+    N: sp.csr_matrix,
+    inert: _Inertia,
+    nz: int,
+    smax: float,
+    atol: float,
+    gap_certain: float,
+    rel_gap: float = 1e-4,
+) -> NullSpace | None:
+    """Rank and gap without the null basis (a wide null space): the smallest singular value
+    above the cut by geometric bisection of the inertia count between ``atol`` (``nz`` below)
+    and ``1.01 sigma_max`` (all below) to ``rel_gap``; the largest below the cut from the
+    Rayleigh quotients of a 16-vector shift-invert block (its Ritz values below τ² are the
+    singular values nearest the cut from below). None when the cut is uncertain (the caller
+    then computes everything)."""
+    m, n = J.shape
+    lo, hi = atol, 1.01 * smax
+    if _count_at(N, hi) <= nz:
+        return None  # the power-iteration sigma_max is too low to bracket the gap
+    while hi > lo * (1.0 + rel_gap):
+        mid = float(np.sqrt(lo * hi))
+        if _count_at(N, mid) > nz:
+            hi = mid
+        else:
+            lo = mid
+    gap = hi  # lo <= sigma_gap <= hi
+    b = min(nz, 16)
+    rng = np.random.default_rng(1)
+    X = rng.standard_normal((n, b))
+    for _ in range(4):
+        X = np.linalg.qr(np.asarray(inert.factor.solve(X)).reshape(n, b))[0]
+    below = np.sort(np.linalg.norm(J @ X, axis=0))
+    if np.any(below > atol):
+        return None
+    sig = np.concatenate([below, [gap]])
+    floor = _FLOOR["sparse-inertia"] * smax
+    ratio = float(gap / max(below[-1], floor))
+    if ratio < gap_certain:
+        return None
+    log.debug("sparse rank without basis: nullity %d, gap ratio %.2e", nz, ratio)
+    return NullSpace(n - nz, None, atol, smax, gap, "sparse-inertia", float(below[-1]), ratio,
+                     True, (n - nz, n - nz), sig)  # fmt: skip

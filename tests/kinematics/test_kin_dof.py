@@ -292,3 +292,30 @@ def test_progress_reports_every_stage_in_order():
     assert "folded state nearby" in stages and stages.count("actuators") == 2
     done = [c[1] for c in calls]
     assert done == sorted(done) and calls[-1][1] == calls[-1][2] == 8
+
+
+def test_wide_flat_null_space_gives_the_same_report_without_flat_actuators(monkeypatch):
+    """Flat Yoshimura 16 x 16 (sparse method): with the flat null vectors skipped (limit
+    below the nullity) every count, gap, local/region DOF and the folded state's actuators
+    equal those of the full computation; the flat state chooses no actuators and says why."""
+    import importlib
+
+    dof_mod = importlib.import_module("barhinge.kinematics.dof")
+    cp = bh.patterns.FAMILIES["yoshimura"](nx=16, ny=16)
+    full = bh.dof(cp)
+    monkeypatch.setattr(dof_mod, "FLAT_BASIS_LIMIT", 50)
+    wide = bh.dof(cp)
+    assert (
+        full.method == "sparse-inertia"
+        and full.global_dof > 50
+        and len(full.actuators) == full.global_dof
+    )
+    for a, b in ((wide, full), (wide.folded, full.folded)):
+        assert (a.global_dof, a.counted_dof, a.redundant, a.rank, a.dof_range, a.certain) == (
+            b.global_dof, b.counted_dof, b.redundant, b.rank, b.dof_range, b.certain
+        )  # fmt: skip
+        assert abs(a.sigma_gap - b.sigma_gap) <= 2e-4 * b.sigma_gap
+        assert np.array_equal(a.local, b.local) and np.array_equal(a.region, b.region)
+    assert np.array_equal(wide.folded.actuators, full.folded.actuators)
+    assert len(wide.actuators) == 0 and "no actuators chosen at this flat state" in wide.note
+    assert wide.global_dof == _nodal_dof(cp, cp.vertices3d)
