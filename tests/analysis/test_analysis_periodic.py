@@ -16,16 +16,16 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from barhinge import patterns
+from barhinge import families
 from barhinge.analysis.periodic import periodic_cell
 from barhinge.errors import ConfigError
+from barhinge.families.miura import miura_geometry
 from barhinge.model.model import BarHingeModel
-from barhinge.patterns.miura import miura_geometry
 
 
 def _cell(a, b, gam, th, scheme="N5B8", n=2, **model_kw):
     g = miura_geometry(a, b, gam, th)
-    cp = patterns.miura(n, n, a=a, b=b, alpha=gam, fold=th)
+    cp = families.miura(n, n, a=a, b=b, alpha=gam, fold=th)
     model = BarHingeModel.from_pattern(cp, scheme, **model_kw)
     return g, model, [[2 * g.L, 0, 0], [0, 2 * g.S, 0]]
 
@@ -84,12 +84,12 @@ def test_result_does_not_depend_on_the_sheet_cut_and_glide_symmetry_removes_coup
     ref = periodic_cell(model, T)
     scale = np.abs(ref.ABD).max()
     for nx, ny in ((3, 2), (3, 3)):
-        cp = patterns.miura(nx, ny, a=1.0, b=1.5, alpha=60.0, fold=50.0)
+        cp = families.miura(nx, ny, a=1.0, b=1.5, alpha=60.0, fold=50.0)
         c = periodic_cell(BarHingeModel.from_pattern(cp, "N5B8"), T)
         np.testing.assert_allclose(c.ABD, ref.ABD, rtol=0, atol=1e-11 * scale)
     assert ref.z0 == pytest.approx(g.H / 2, rel=1e-12)
     assert np.abs(ref.B).max() < 1e-12 * scale
-    cp = patterns.miura(2, 2, a=1.0, b=1.5, alpha=60.0, fold=50.0)
+    cp = families.miura(2, 2, a=1.0, b=1.5, alpha=60.0, fold=50.0)
     mirrored = BarHingeModel.from_pattern(cp.replaced(vertices=cp.vertices * [1, 1, -1]), "N5B8")
     np.testing.assert_allclose(periodic_cell(mirrored, T).ABD, ref.ABD, rtol=0, atol=1e-11 * scale)
     # symmetric, positive definite (finite fold stiffness: no periodic mechanism)
@@ -101,7 +101,7 @@ def _kinematic_sheet_abd(n: int, z0: float, area: float) -> np.ndarray:
     """ABD of an n x n-cell Miura sheet with the macroscopic field prescribed on every
     boundary vertex and the interior free (energy per projected area of n^2 cells); built
     from the sheet's tangent only."""
-    cp = patterns.miura(n, n, a=1.0, b=1.5, alpha=60.0, fold=50.0)
+    cp = families.miura(n, n, a=1.0, b=1.5, alpha=60.0, fold=50.0)
     m = BarHingeModel.from_pattern(cp, "N5B8")
     X = m.X0
     x, y, _ = (X - X.mean(0)).T
@@ -150,7 +150,7 @@ def _free_sheet_centre_strain(n: int, d: int, g) -> np.ndarray:
     from barhinge.analysis.stiffness import linear_response
     from barhinge.scene import restraint_321
 
-    cp = patterns.miura(n, n, a=1.0, b=1.5, alpha=60.0, fold=50.0)
+    cp = families.miura(n, n, a=1.0, b=1.5, alpha=60.0, fold=50.0)
     m = BarHingeModel.from_pattern(cp, "N5B8")
     ni = 2 * n + 1
     vid = np.arange(ni * ni).reshape(ni, ni)  # vid[j, i]
@@ -202,7 +202,7 @@ def test_bad_input_is_a_config_error():
         periodic_cell(model, [[2 * g.L * 1.01, 0, 0], [0, 2 * g.S, 0]])
     with pytest.raises(ConfigError, match="shape"):
         periodic_cell(model, [1.0, 2.0])
-    one = BarHingeModel.from_pattern(patterns.miura(1, 1, a=1.0, b=1.5, alpha=60.0, fold=50.0))
+    one = BarHingeModel.from_pattern(families.miura(1, 1, a=1.0, b=1.5, alpha=60.0, fold=50.0))
     with pytest.raises(ConfigError, match="2 x 2 periods"):
         periodic_cell(one, T)
 
