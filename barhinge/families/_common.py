@@ -25,7 +25,7 @@ __all__ = [
     "check_range",
     "edges_from_faces",
     "grid_layout",
-    "signed_assignment",
+    "mv_assignment",
 ]
 
 
@@ -113,11 +113,24 @@ def edges_from_faces(faces: Sequence[Sequence[int]] | np.ndarray) -> tuple[np.nd
     return edges, counts
 
 
-def signed_assignment(rho_deg: np.ndarray, boundary: np.ndarray, tol: float = 1e-9) -> np.ndarray:
-    """Assignment letters from signed fold angles: V if rho > tol, M if rho < -tol, else F;
-    ``B`` where ``boundary`` is True."""
-    A = np.where(rho_deg > tol, "V", np.where(rho_deg < -tol, "M", "F")).astype("<U1")
-    A[boundary] = "B"
+def mv_assignment(reference_rho_deg: np.ndarray, boundary: np.ndarray) -> np.ndarray:
+    """Assignment letters of a generated family from a reference folded state.
+
+    Parameters
+    ----------
+    reference_rho_deg : (n_edges,) float
+        Signed fold angles of any folded state of the family's branch, degrees (valley > 0).
+    boundary : (n_edges,) bool
+        Boundary edges.
+
+    Returns
+    -------
+    (n_edges,) str
+        ``"V"`` where the reference folds as a valley (rho > 0), ``"M"`` elsewhere, ``"B"``
+        on the boundary.
+    """
+    A = np.where(np.asarray(reference_rho_deg) > 0, "V", "M").astype("<U1")
+    A[np.asarray(boundary, dtype=bool)] = "B"
     return A
 
 

@@ -33,6 +33,7 @@ from barhinge.families._common import (
     check_int,
     check_range,
     fold_angles_of,
+    mv_assignment,
 )
 from barhinge.pattern.crease import CreasePattern
 
@@ -105,9 +106,8 @@ def eggbox(
     faces = lay.quads()
     edges = lay.edges()
     rho = fold_angles_of(X, faces, edges)
-    A = np.where(rho > 0, "V", "M")
     bnd = lay.boundary_mask()
-    A[bnd] = "B"
+    A = mv_assignment(rho, bnd)
     rho[bnd] = 0.0
     return build_pattern(
         X,

@@ -45,6 +45,7 @@ from barhinge.families._common import (
     check_int,
     check_range,
     grid_layout,
+    mv_assignment,
 )
 from barhinge.pattern.crease import CreasePattern
 
@@ -289,8 +290,7 @@ def miura(
     if fold is None:
         X = X[:, :2]
     rho = miura_fold_angles(lay, alpha, target if fold is None else fold)
-    A = np.where(miura_fold_angles(lay, alpha, 45.0) > 0, "V", "M")
-    A[lay.boundary_mask()] = "B"
+    A = mv_assignment(miura_fold_angles(lay, alpha, 45.0), lay.boundary_mask())
     params = {"nx": lay.ni // 2, "ny": lay.nj // 2, "a": a, "b": b, "alpha": alpha, "fold": fold}
     if fold is None:
         params["target"] = target

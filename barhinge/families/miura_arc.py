@@ -45,6 +45,7 @@ from barhinge.families._common import (
     check_int,
     check_range,
     fold_angles_of,
+    mv_assignment,
 )
 from barhinge.pattern.crease import CreasePattern
 
@@ -172,9 +173,8 @@ def miura_arc(
     faces = lay.quads()
     edges = lay.edges()
     ref = fold_angles_of(_folded(a, h, gam, ny, 60.0), faces, edges)
-    A = np.where(ref > 0, "V", "M")
     bnd = lay.boundary_mask()
-    A[bnd] = "B"
+    A = mv_assignment(ref, bnd)
     if fold is None:
         X = np.column_stack([I * a + (J % 2) * off[I], J * h])
         rho = fold_angles_of(_folded(a, h, gam, ny, target), faces, edges)

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from barhinge.errors import PatternError
-from barhinge.families._common import GridLayout, build_pattern, check_range
+from barhinge.families._common import GridLayout, build_pattern, check_range, mv_assignment
 from barhinge.families.miura import DEFAULT_TARGET_THETA, miura_fold_angles, miura_grid_coords
 from barhinge.pattern.crease import CreasePattern
 
@@ -96,8 +96,7 @@ def miura_from_lengths(
     if fold is None:
         X = X[:, :2]
     rho = miura_fold_angles(lay, alpha, target if fold is None else fold)
-    A = np.where(miura_fold_angles(lay, alpha, 45.0) > 0, "V", "M")
-    A[lay.boundary_mask()] = "B"
+    A = mv_assignment(miura_fold_angles(lay, alpha, 45.0), lay.boundary_mask())
     return build_pattern(
         X,
         lay.quads(),

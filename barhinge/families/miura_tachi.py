@@ -37,6 +37,7 @@ from barhinge.families._common import (
     check_int,
     check_range,
     fold_angles_of,
+    mv_assignment,
     unfold,
 )
 from barhinge.pattern.crease import CreasePattern
@@ -164,9 +165,8 @@ def miura_tachi(
     faces = lay.quads()
     edges = lay.edges()
     rho = fold_angles_of(X, faces, edges)
-    A = np.where(rho > 0, "V", "M")
     bnd = lay.boundary_mask()
-    A[bnd] = "B"
+    A = mv_assignment(rho, bnd)
     rho[bnd] = 0.0
     Xout = X if folded else unfold(X, faces)
     return build_pattern(

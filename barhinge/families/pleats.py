@@ -14,7 +14,13 @@ import math
 
 import numpy as np
 
-from barhinge.families._common import GridLayout, build_pattern, check_int, check_range
+from barhinge.families._common import (
+    GridLayout,
+    build_pattern,
+    check_int,
+    check_range,
+    mv_assignment,
+)
 from barhinge.pattern.crease import CreasePattern
 
 __all__ = ["curved_pleats", "pleats"]
@@ -73,8 +79,7 @@ def pleats(
     rho_col = np.zeros(n + 1)
     rho_col[1:n] = sign_crease * mag
     rho = np.concatenate([rho_row, rho_col])
-    A = np.where(rho > 0, "V", "M")
-    A[lay.boundary_mask()] = "B"
+    A = mv_assignment(rho, lay.boundary_mask())
     return build_pattern(
         X,
         lay.quads(),

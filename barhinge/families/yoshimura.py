@@ -43,6 +43,7 @@ from barhinge.families._common import (
     check_range,
     edges_from_faces,
     fold_angles_of,
+    mv_assignment,
     zip_strip,
 )
 from barhinge.pattern.crease import CreasePattern
@@ -161,8 +162,7 @@ def yoshimura(
     boundary = counts == 1
     ref = _arch_coords(u, j, nx, w, h, min(10.0, 0.5 * fmax))
     sign = np.sign(fold_angles_of(ref, faces, edges))
-    A = np.where(sign > 0, "V", "M")
-    A[boundary] = "B"
+    A = mv_assignment(sign, boundary)
     if fold is None:
         X = np.column_stack([u * w, j * h])
         rho = fold_angles_of(_arch_coords(u, j, nx, w, h, target), faces, edges)
