@@ -16,7 +16,7 @@ import signal
 import sys
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any, Literal
 
 import typer
 from rich.console import Console
@@ -64,10 +64,11 @@ def _sigterm_as_interrupt() -> Iterator[None]:
 
 def _terminated(exc: BaseException) -> bool:
     """Whether ``exc`` (or what it was raised from) is a SIGTERM."""
-    while exc is not None:
-        if isinstance(exc, _Terminated):
+    link: BaseException | None = exc
+    while link is not None:
+        if isinstance(link, _Terminated):
             return True
-        exc = exc.__cause__ or exc.__context__
+        link = link.__cause__ or link.__context__
     return False
 
 
@@ -374,7 +375,7 @@ def fold_cmd(
     level = picture_level(pictures)  # a bad value stops before the solve
     scene = default_scene() if scene_file is None else load_scene(scene_file)
     check_output_folder(out, overwrite=overwrite)  # before the solve, not after
-    opts = {"overwrite": overwrite, "pictures": level, "viewer": viewer}
+    opts: dict[str, Any] = {"overwrite": overwrite, "pictures": level, "viewer": viewer}
     if form_only and form_only_model(scene)[0] == "rigid":
         try:
             rigid = rigid_form(scene)
@@ -546,7 +547,9 @@ def study(
     from barhinge.sweep import SweepReport, load_study, run_study
 
     spec = load_study(study_file)
-    mode = "serial" if serial else ("dask" if scheduler else "local")
+    mode: Literal["serial", "local", "dask"] = (
+        "serial" if serial else ("dask" if scheduler else "local")
+    )
     progress = Progress(
         TextColumn("[bold]{task.description}"),
         BarColumn(),
@@ -621,7 +624,7 @@ def verify_cmd(
     from barhinge import verify
 
     if list_cases:  # the cases --case and --quick select, as a run would
-        data = {
+        data: dict[str, dict[str, Any]] = {
             c.name: {
                 "citation": c.citation,
                 "description": c.description,

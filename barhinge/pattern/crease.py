@@ -15,7 +15,6 @@ Conventions
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
 from functools import cached_property
 from typing import Any
 
@@ -57,7 +56,8 @@ class CreasePattern:
     fold_angles : (m,) float, optional
         Target fold angle per edge in degrees (valley > 0, mountain < 0). Defaults to 0.
     faces : sequence of int sequences, optional
-        Counter-clockwise vertex loops. Derived from the planar graph when omitted.
+        Counter-clockwise vertex loops. Derived from the planar graph when omitted; stored as
+        a tuple of int tuples.
     developable : bool
         Require sector angles to sum to 360 deg at flat interior vertices (set False for
         non-developable families such as the egg-box).
@@ -73,8 +73,8 @@ class CreasePattern:
     vertices: np.ndarray
     edges: np.ndarray
     assignment: np.ndarray
-    fold_angles: np.ndarray | None = None
-    faces: Sequence[Sequence[int]] | None = None
+    fold_angles: Any = None  # (m,) float or None in, (m,) float array stored
+    faces: Any = None  # Sequence[Sequence[int]] | None in, tuple[tuple[int, ...], ...] stored
     developable: bool = True
     meta: dict[str, Any] = dataclasses.field(default_factory=dict)
     validate: dataclasses.InitVar[bool] = True
