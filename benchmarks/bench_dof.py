@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 import barhinge as bh
+from barhinge._publish import write_between
 from barhinge.pattern.io import read
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -147,11 +148,8 @@ def main() -> None:
                 f"* {fam}: time ~ creases^{c[0]:.2f} ({parts}); at 10 000 creases (fit): {at:.1f} s"
             )
     if a.publish:
-        doc = DOC.read_text()
-        i, j = doc.index(START), doc.index(END)
         cmd = "python benchmarks/bench_dof.py " + " ".join(sys.argv[1:])
-        body = "\n".join([f"`{cmd}`:", "", *LINES])
-        DOC.write_text(doc[: i + len(START)] + "\n" + body + "\n" + doc[j:])
+        write_between(DOC, START, END, "\n".join([f"`{cmd}`:", "", *LINES]))
         print(f"wrote {DOC}")
 
 

@@ -28,6 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
+from barhinge._publish import write_between
+
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "tests" / "data" / "crease-patterns"
 CATALOGUE = ROOT / "data" / "patterns"
@@ -171,9 +173,7 @@ def main() -> None:
     print()
     print(text)
     if a.publish:
-        doc = DOC.read_text()
-        i, j = doc.index(START), doc.index(END)
-        DOC.write_text(doc[: i + len(START)] + "\n" + text + doc[j:])
+        write_between(DOC, START, END, text)
         print(f"wrote {DOC}")
 
 

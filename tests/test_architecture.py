@@ -41,6 +41,7 @@ LAYERS: list[tuple[str, list[str]]] = [
             "barhinge._json",
             "barhinge._protocols",
             "barhinge._deprecated",
+            "barhinge._publish",
         ],
     ),
     ("linalg", ["barhinge.linalg", "barhinge.linalg.*"]),
