@@ -176,8 +176,8 @@ def patterns_cmd(
     """List the parametric pattern families, or generate one (``--out FILE.fold``)."""
     from rich.table import Table
 
+    from barhinge.families.spec import catalogue, family_kwargs, generate
     from barhinge.pattern.info import generated_info
-    from barhinge.patterns.spec import catalogue, family_kwargs, generate
 
     if name is None:
         data = catalogue()
@@ -248,7 +248,7 @@ def dof(
         )
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from barhinge.patterns.spec import read_or_generate
+    from barhinge.families.spec import read_or_generate
 
     cp = read_or_generate(pattern)
     bar = Progress(
@@ -368,8 +368,8 @@ def fold_cmd(
     from barhinge.output.run import picture_level, write_run
     from barhinge.results import Interrupted
     from barhinge.scene import default_scene, load_scene
-    from barhinge.solve.form import form_only_model, rigid_form
-    from barhinge.solve.newton import solve
+    from barhinge.solver.form import form_only_model, rigid_form
+    from barhinge.solver.newton import solve
 
     level = picture_level(pictures)  # a bad value stops before the solve
     scene = default_scene() if scene_file is None else load_scene(scene_file)

@@ -9,7 +9,7 @@ Usage: python benchmarks/bench_dof.py [--sizes 10 20 35 50 70] [--repeat 3] [--n
 ``--publish`` writes the table and the fitted exponents into docs/kinematics.md between the
 ``dof-scale:start`` / ``dof-scale:end`` markers.
 
-Generated sheets (n x n unit cells of ``bh.patterns.miura``, ``yoshimura`` and ``eggbox``)
+Generated sheets (n x n unit cells of ``bh.families.miura``, ``yoshimura`` and ``eggbox``)
 and the two box-pleated FOLD files of Origami Simulator kept with the tests. Printed per
 pattern: crease variables, DOF at the flat state and at the folded state nearby (with the
 gap ratio of the rank cut), the median wall time and its split over the stages (both
@@ -91,9 +91,9 @@ def row(name: str, cp, repeat: int) -> tuple[bh.DofReport, float, dict[str, floa
 
 
 FAMILY = {
-    "miura": lambda n: bh.patterns.miura(n, n),
-    "yoshimura": lambda n: bh.patterns.FAMILIES["yoshimura"](nx=n, ny=n),
-    "eggbox": lambda n: bh.patterns.FAMILIES["eggbox"](nx=n, ny=n),
+    "miura": lambda n: bh.families.miura(n, n),
+    "yoshimura": lambda n: bh.families.FAMILIES["yoshimura"](nx=n, ny=n),
+    "eggbox": lambda n: bh.families.FAMILIES["eggbox"](nx=n, ny=n),
 }
 
 

@@ -41,7 +41,7 @@ def stress_patterns(folder: Path) -> list[tuple[str, list[str]]]:
     from barhinge.pattern.fold import write_fold
 
     out = [("Miura 35 × 35 (generated)", ["miura:nx=35,ny=35"])]
-    cp = bh.patterns.miura(30, 30)
+    cp = bh.families.miura(30, 30)
     drop = {cp.n_faces // 4 + 7, cp.n_faces // 2 + 31, 3 * cp.n_faces // 4 + 11}
     faces = [f for i, f in enumerate(cp.faces) if i not in drop]
     asg = cp.assignment.copy()
@@ -54,7 +54,7 @@ def stress_patterns(folder: Path) -> list[tuple[str, list[str]]]:
     out.append(
         ("Miura 30 × 30, 3 panels removed (generated)", [str(folder / "miura30_3holes.fold")])
     )
-    y = bh.patterns.FAMILIES["yoshimura"](nx=12, ny=12)
+    y = bh.families.FAMILIES["yoshimura"](nx=12, ny=12)
     asg = y.assignment.copy()
     mv = np.flatnonzero(np.isin(asg, ["M", "V"]))
     asg[mv[::2]] = "U"

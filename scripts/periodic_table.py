@@ -24,11 +24,11 @@ from pathlib import Path
 import numpy as np
 
 import barhinge
-from barhinge import patterns
+from barhinge import families
 from barhinge.analysis.periodic import kinematic_abd, periodic_cell
 from barhinge.analysis.stiffness import linear_response
+from barhinge.families.miura import miura_geometry
 from barhinge.model.model import BarHingeModel
-from barhinge.patterns.miura import miura_geometry
 from barhinge.scene import restraint_321
 
 REPO = Path(__file__).resolve().parents[1]
@@ -44,7 +44,7 @@ TERMS = ((0, 0, "A11"), (1, 1, "A22"), (2, 2, "A66"), (3, 3, "D11"), (4, 4, "D22
 
 def _model(geom, n, **kw):
     a, b, gam, th = geom
-    cp = patterns.miura(n, n, a=a, b=b, alpha=gam, fold=th)
+    cp = families.miura(n, n, a=a, b=b, alpha=gam, fold=th)
     return BarHingeModel.from_pattern(cp, "N5B8", **kw)
 
 

@@ -239,7 +239,7 @@ def test_jupyter_shows_the_viewer(browser, tmp_path):
         "import numpy as np\n"
         "import barhinge as bh\n"
         "from barhinge.results import FoldPath\n"
-        "cps = [bh.patterns.miura(nx=2, ny=2, fold=t) for t in (10.0, 50.0)]\n"
+        "cps = [bh.families.miura(nx=2, ny=2, fold=t) for t in (10.0, 50.0)]\n"
         "path = FoldPath(X=np.stack([c.vertices3d for c in cps]),\n"
         "                fold_angles_deg=np.stack([c.fold_angles for c in cps]), kind='rigid')\n"
         "path"
