@@ -389,6 +389,21 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
     const [x0, y0] = tr(CR[2 * e]), [x1, y1] = tr(CR[2 * e + 1]);
     g.moveTo(x0, y0); g.lineTo(x1, y1);
   }
+  function rasterLines(img, tr, dpr, list, col) {  // DDA lines into RGBA pixels
+    const px = img.data, W = img.width, H = img.height;
+    const R = Math.round(255 * col[0]), G = Math.round(255 * col[1]), Bc = Math.round(255 * col[2]);
+    for (const e of list) {
+      const a = tr(CR[2 * e]), b = tr(CR[2 * e + 1]);
+      const x0 = a[0] * dpr, y0 = a[1] * dpr, dx = b[0] * dpr - x0, dy = b[1] * dpr - y0;
+      const n = Math.max(1, Math.ceil(Math.max(Math.abs(dx), Math.abs(dy))));
+      for (let t = 0; t <= n; t++) {
+        const x = Math.round(x0 + (dx * t) / n), y = Math.round(y0 + (dy * t) / n);
+        if (x < 0 || y < 0 || x >= W || y >= H) continue;
+        const i = 4 * (y * W + x);
+        px[i] = R; px[i + 1] = G; px[i + 2] = Bc; px[i + 3] = 255;
+      }
+    }
+  }
   function drawCP() {
     const dpr = window.devicePixelRatio || 1, w = cpc.clientWidth, h = cpc.clientHeight;
     const W = Math.round(w * dpr), H = Math.round(h * dpr);
@@ -402,12 +417,23 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
         if (!groups.has(k)) groups.set(k, []);
         groups.get(k).push(e);
       }
+      // many creases: one pixel wide lines set straight into the image (a canvas strokes
+      // 10^5 segments in seconds in a software renderer); actuators stroked on top
+      const raster = E > 5000, img = raster ? g.createImageData(W, H) : null;
       for (const [k, list] of groups) {
         const col = k === "act" ? [0.1, 0.7, 0.2] : MV[k] || MV.U;
+        if (raster && k !== "act") { rasterLines(img, tr, dpr, list, col); continue; }
         g.strokeStyle = `rgb(${col.map((x) => Math.round(255 * x)).join(",")})`;
-        g.lineWidth = k === "act" ? 2.5 : E > 5000 ? 0.6 : 1.4;
-        g.setLineDash(k === "M" && E <= 5000 ? [6, 3] : []);
+        g.lineWidth = k === "act" ? 2.5 : 1.4;
+        g.setLineDash(k === "M" ? [6, 3] : []);
+        if (raster) continue;
         g.beginPath(); for (const e of list) strokeCrease(g, tr, e); g.stroke();
+      }
+      if (raster) {
+        g.putImageData(img, 0, 0);
+        const act = groups.get("act") || [];
+        g.strokeStyle = "rgb(26,179,51)"; g.lineWidth = 2.5; g.setLineDash([]);
+        g.beginPath(); for (const e of act) strokeCrease(g, tr, e); g.stroke();
       }
     }
     cpc.width = W; cpc.height = H;
