@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import io
 import shutil
+import time
 from pathlib import Path
 
 import numpy as np
@@ -252,9 +253,18 @@ def test_jupyter_shows_the_viewer(browser, tmp_path):
     page = tmp_path / "notebook_output.html"
     page.write_text(f"<!DOCTYPE html><html><body>{html}</body></html>", encoding="utf-8")
     browser.get(page.as_uri())
-    browser.switch_to.frame(browser.find_element("tag name", "iframe"))
     try:
-        assert browser.execute_script("return window.barhingeViewer && barhingeViewer.ready")
+        # the frame's document may still be loading after the page's load event (and the
+        # frame handle may then point at its first, blank document): look again until ready
+        deadline = time.monotonic() + 30
+        while True:
+            browser.switch_to.default_content()
+            browser.switch_to.frame(browser.find_element("tag name", "iframe"))
+            js = "return !!(window.barhingeViewer && barhingeViewer.ready && barhingeViewer.drawn)"
+            if browser.execute_script(js) or time.monotonic() > deadline:
+                break
+            time.sleep(0.2)
+        assert browser.execute_script(js), browser.get_log("browser")
         assert browser.execute_script("return barhingeViewer.state") == 1
         img = _canvas(browser, "gl")
         assert (np.abs(img - 255).sum(axis=2) > 24).mean() > 0.01  # the sheet is drawn

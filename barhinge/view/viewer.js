@@ -354,6 +354,7 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
     gl.drawArrays(gl.LINES, 0, lines.nl + lines.nLoad);
     if (lines.np) gl.drawArrays(gl.POINTS, lines.nl + lines.nLoad, lines.np);
     gl.bindVertexArray(null);
+    V.drawn = cv.width * cv.height;  // pixels of the last drawing (0 before layout)
   }
 
   // camera: left drag orbits, right drag or shift-drag pans, wheel zooms
@@ -407,6 +408,7 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
   function drawCP() {
     const dpr = window.devicePixelRatio || 1, w = cpc.clientWidth, h = cpc.clientHeight;
     const W = Math.round(w * dpr), H = Math.round(h * dpr);
+    if (!W || !H) return;  // not laid out yet (a hidden or collapsed frame): drawn on resize
     const tr = cpTransform();
     if (!cpBase || cpBase.width !== W || cpBase.height !== H) {
       cpBase = document.createElement("canvas"); cpBase.width = W; cpBase.height = H;
@@ -548,7 +550,10 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
     play.textContent = "\u275a\u275a pause";
     timer = setInterval(() => setState(V.state >= S - 1 ? 0 : V.state + 1), Math.max(40, 3000 / S));
   });
-  window.addEventListener("resize", () => { drawCP(); drawBar(); drawCharts(); draw(); });
+  const redraw = () => { if (V.ready) { drawCP(); drawBar(); drawCharts(); draw(); } };
+  window.addEventListener("resize", redraw);
+  // a frame laid out after the script ran (Jupyter output, a hidden tab) has no window resize
+  if (window.ResizeObserver) { const ro = new ResizeObserver(redraw); ro.observe(cv); ro.observe(cpc); }
 
   const sum = document.getElementById("summary");
   for (const [k, v] of Object.entries(D.summary)) {
@@ -569,6 +574,7 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
   // for tests and scripts: drive the viewer and read what it shows
   window.barhingeViewer = {
     get state() { return V.state; }, get mode() { return V.mode; }, get ready() { return V.ready; },
+    get drawn() { return V.drawn || 0; },
     modes: Object.keys(MODES), setState, setMode, field: (m, s) => Array.from(MODES[m].f(s)),
     creasePoint: (e) => { const tr = cpTransform(), a = tr(CR[2 * e]), b = tr(CR[2 * e + 1]); return [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2]; },
     camera: cam, timing, positions: (s) => Array.from(pos(s)), eps: EPS,
