@@ -1,6 +1,7 @@
 """Viewer file size and opening time: the default scene (solved) and large Miura fold paths
 (30 rigidly folded states from the closed form, ``miura(nx, ny, fold=theta)``), opened in
-headless Chromium offline; "play" is the mean time of one state change over all states.
+headless Chromium offline (from a blank tab: file read, parse, script, first drawing); "play"
+is the mean time of one state change over all states.
 The large paths are written twice: with float32 positions and with the default precision
 (16-bit positions above ``QUANTISE_ABOVE`` node-states).
 
@@ -39,6 +40,7 @@ def miura_path(n: int, states: int = 30):
 def open_time(drv, html: Path, repeat: int) -> tuple[float, float]:
     opens, plays = [], []
     for _ in range(repeat):
+        drv.get("about:blank")  # the previous page's teardown is not part of opening this one
         t = time.perf_counter()
         drv.get(html.as_uri())
         assert drv.execute_script("return barhingeViewer.ready")
