@@ -107,7 +107,8 @@ def publish(rows, repeat: int) -> None:
     lines = [
         "<!-- viewer-bench:start -->",
         f"Written by `python benchmarks/bench_viewer.py --publish` (headless Chromium with its "
-        f"software renderer, 2 shared cores; medians of {repeat} openings):",
+        f"software renderer, 2 shared cores; open: from a blank tab to the first drawing, median "
+        f"of {repeat}):",
         "",
         "| path | nodes | states | file MB | write s | open s | s per state change |",
         "|---|---:|---:|---:|---:|---:|---:|",
