@@ -63,7 +63,8 @@ class PlateHinges:
         hinges and the ``F``-line fold hinges replaced (creases keep theirs)
     residual : (n_faces,) float, largest entry of the cell's energy mismatch over ``D``
         (0 = the cell passes the uniform-curvature patch test)
-    changed : (n_hinges,) bool, hinges whose stiffness the rule set
+    changed : (n_hinges,) bool, hinges whose stiffness the rule set (every hinge inside or
+        between cells; creases get their spring in series with the plate strip)
     """
 
     hinge_k: np.ndarray
@@ -169,7 +170,9 @@ def _cells_2d(X: np.ndarray, F: np.ndarray) -> np.ndarray:
 def consistent_hinge_stiffness(model: BarHingeModel) -> PlateHinges:
     """Plate-consistent stiffnesses of the bend hinges and the ``F``-line fold hinges of an
     N5B8 model of a (subdivided) pattern with triangular or quadrilateral faces (module
-    docstring). Crease (M, V, U) hinges keep their stiffness."""
+    docstring). A crease (M, V, U) hinge gets its spring ``k_c`` in series with the plate
+    strip ``k_s`` of the two half-cells beside it, ``k_c k_s / (k_c + k_s)``: its angle is the
+    crease's own rotation plus the bending of that strip."""
     cp = model.pattern
     if model.scheme != "N5B8":
         raise ConfigError(f"consistent bending needs an N5B8 model, got {model.scheme}")
@@ -223,13 +226,22 @@ def consistent_hinge_stiffness(model: BarHingeModel) -> PlateHinges:
     flat_line = ~bend & (np.asarray(model.hinge_edge) >= 0)
     flat_line &= np.asarray(cp.assignment)[np.maximum(model.hinge_edge, 0)] == "F"
     k_new[flat_line] = side_k[np.asarray(model.hinge_edge)[flat_line]]
+    # creases: the crease spring in series with the plate strip of the two half-cells
+    # beside it (the hinge's angle is the crease's own rotation plus the strip's bending)
+    crease = ~bend & ~flat_line & (np.asarray(model.hinge_edge) >= 0)
+    ks = side_k[np.asarray(model.hinge_edge)[crease]]
+    kc = k_new[crease]
+    with np.errstate(divide="ignore"):
+        k_new[crease] = np.where((ks > 0) & (kc > 0), kc * ks / (kc + ks), kc)
     logger.debug(
         "consistent bending: %d bend + %d flat-line hinges, largest cell residual %.2g",
         int(bend.sum()),
         int(flat_line.sum()),
         float(residual.max(initial=0.0)),
     )
-    return PlateHinges(hinge_k=k_new, residual=residual, changed=bend | flat_line)
+    changed = bend | flat_line
+    changed[np.flatnonzero(crease)[(ks > 0) & (kc > 0)]] = True
+    return PlateHinges(hinge_k=k_new, residual=residual, changed=changed)
 
 
 def consistent_bending(model: BarHingeModel) -> BarHingeModel:
