@@ -53,6 +53,7 @@ __all__ = [
     "choose_model",
     "parse_accuracy",
     "richardson",
+    "scene_for_accuracy",
     "subdivided_scene",
 ]
 
@@ -380,3 +381,18 @@ def _choose_actuated(scene, acc: float, outs: tuple[str, ...]) -> ModelChoice:
     own = Candidate(model.scheme, model.scheme, 1, 3 * model.n_nodes, {}, {"form": 0.0}, t_bh)
     chosen = rigid if err <= acc else own
     return ModelChoice(chosen, (rigid, own), acc, outs, {}, {})
+
+
+def scene_for_accuracy(scene, accuracy: float | str, outputs: tuple[str, ...] | None = None):
+    """(scene to run, ModelChoice): the scene rebuilt on the model :func:`choose_model` picks
+    (the scene itself for the rigid form or the scene's own model). ``outputs`` default:
+    the form for a scene driven by actuators alone, else the stiffness."""
+    from barhinge.solve.form import form_only_model
+
+    if not outputs:
+        outputs = ("form",) if form_only_model(scene)[0] == "rigid" else ("stiffness",)
+    ch = choose_model(scene, accuracy, outputs)
+    c = ch.chosen
+    if c.name == "rigid" or (c.m == 1 and c.scheme == scene.model.scheme):
+        return scene, ch
+    return subdivided_scene(scene, c.m, c.scheme), ch

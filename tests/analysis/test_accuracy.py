@@ -92,3 +92,24 @@ def test_bad_outputs_and_unreachable_accuracy_are_named_errors():
         choose_model(_roof(), "2%", outputs=("stress",))
     with pytest.raises(bh.errors.ConvergenceError, match="no model up to m = 2"):
         choose_model(_roof(), "0.1%", max_m=2)
+
+
+def test_cli_fold_accuracy(tmp_path, capsys):
+    import json
+
+    from typer.testing import CliRunner
+
+    from barhinge.cli import app
+
+    out = tmp_path / "run"
+    res = CliRunner().invoke(app, ["fold", "--out", str(out), "--accuracy", "15%", "--no-viewer"])
+    assert res.exit_code == 0, res.output
+    choice = json.loads((out / "summary.json").read_text())["model_choice"]
+    assert choice["model"] == "rigid" and choice["estimated_error"]["form"] <= 0.15
+    from barhinge.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["fold", "--out", str(tmp_path / "bad"), "--accuracy", "two"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "accuracy" in err and "Traceback" not in err
