@@ -49,6 +49,8 @@ logger = logging.getLogger(__name__)
 
 __all__ = ["PlateHinges", "cell_fit", "consistent_bending", "consistent_hinge_stiffness"]
 
+#: weight of the pull of each hinge group towards 4/3 D in the cell fit (log scale)
+REGULARISATION = 1e-3
 #: relative rounding of cell shapes (normalised by sqrt(area)) when grouping equal cells
 SHAPE_DIGITS = 6
 
@@ -148,10 +150,16 @@ def cell_fit(P: np.ndarray, nu: float) -> tuple[np.ndarray, float, float]:
     def mismatch(x: np.ndarray) -> np.ndarray:
         return (_condensed(x[:ng][grp], rows, w) / area - plate - x[ng] * null).ravel()
 
+    def objective(x: np.ndarray) -> np.ndarray:
+        # the energy rows, and a weak pull of every stiffness towards the square cell's
+        # 4/3: where the energy does not fix a group (a family of exact fits) the fit
+        # takes the moderate member instead of a near-rigid hinge, which would lock
+        return np.concatenate([mismatch(x), REGULARISATION * np.log(x[:ng] / (4.0 / 3.0))])
+
     x0 = np.append(np.full(ng, 4.0 / 3.0), -(1.0 / 3.0 + nu))
-    lo = np.append(np.zeros(ng), -np.inf)
-    sol = least_squares(mismatch, x0, bounds=(lo, np.inf), xtol=1e-14, ftol=1e-14, gtol=1e-14)
-    return sol.x[:ng][grp], float(sol.x[ng]), float(np.abs(sol.fun).max())
+    lo = np.append(np.full(ng, 1e-6), -np.inf)
+    sol = least_squares(objective, x0, bounds=(lo, np.inf), xtol=1e-14, ftol=1e-14, gtol=1e-14)
+    return sol.x[:ng][grp], float(sol.x[ng]), float(np.abs(mismatch(sol.x)).max())
 
 
 def _cells_2d(X: np.ndarray, F: np.ndarray) -> np.ndarray:
