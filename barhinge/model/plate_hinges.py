@@ -24,7 +24,8 @@ for the parallelogram and barycentric-triangle grids of ``subdivided``). Hinge e
 hinge group (opposite sides, the two halves of a diagonal; the three sides of a triangle) and
 ``lambda`` by bounded least squares (``k >= 0``), relative to ``D``. The fit is exact
 (residual ~1e-12) for squares (every hinge ``4 D / 3``, ``lambda = -(1/3 + nu) D``),
-rectangles of aspect ratio up to about 1.6, and equilateral triangles (``2 D / sqrt 3``); it
+rectangles of aspect ratio up to about 1.6, equilateral triangles (``2 D / sqrt 3``) and
+the 60-degree rhombus (only as its long-diagonal hinges become near rigid, ~3e4 D); it
 leaves a residual for elongated rectangles, oblique parallelograms and right or isosceles
 triangles, which is reported (``PlateHinges.residual``): such cells converge to a plate with
 the wrong anisotropy, not to the Kirchhoff plate.
@@ -159,6 +160,8 @@ def cell_fit(P: np.ndarray, nu: float) -> tuple[np.ndarray, float, float]:
     x0 = np.append(np.full(ng, 4.0 / 3.0), -(1.0 / 3.0 + nu))
     lo = np.append(np.full(ng, 1e-6), -np.inf)
     sol = least_squares(objective, x0, bounds=(lo, np.inf), xtol=1e-14, ftol=1e-14, gtol=1e-14)
+    # polish without the pull: the exact fit next to the moderate one
+    sol = least_squares(mismatch, sol.x, bounds=(lo, np.inf), xtol=1e-14, ftol=1e-14, gtol=1e-14)
     return sol.x[:ng][grp], float(sol.x[ng]), float(np.abs(mismatch(sol.x)).max())
 
 
