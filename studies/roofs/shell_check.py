@@ -278,7 +278,8 @@ def run() -> list[dict]:
             err = np.array([b["stiffness"] / ref - 1.0 for b in rows])
             errors[v] = err.tolist()
             # rate over the levels m >= 2 (m = 1 has no flat lines)
-            sel = (ms >= 2) & (np.abs(err) > 0)
+            sel = (ms >= 2) if (ms >= 2).sum() >= 2 else np.ones(len(ms), bool)
+            sel &= np.abs(err) > 0
             rates[v] = (
                 float(-np.polyfit(np.log(ms[sel]), np.log(np.abs(err[sel])), 1)[0])
                 if sel.sum() >= 2
@@ -438,8 +439,12 @@ def prose(results: list[dict], plate: dict) -> str:
         nu: extrapolate([s_["stiffness"] for s_ in rows])[0] for nu, rows in fe["shell"].items()
     }
     nu = next(iter(fe_sh))
-    ok = [r for r in results if r["patch_residual"] < 1e-6]
-    bad = [r for r in results if r["patch_residual"] >= 1e-6]
+    from barhinge.model.plate_hinges import cell_fit
+
+    nu_s = roofs.MATERIAL["nu"]
+    nu_eff = nu_s + cell_fit(np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]]), nu_s)[1]
+    ok = [r for r in results if r["patch_residual"] < 1e-3]
+    bad = [r for r in results if r["patch_residual"] >= 1e-3]
     within = [
         r for r in results if abs(r["consistent_reference"] / r["shell_reference"] - 1.0) <= 0.05
     ]
@@ -460,25 +465,27 @@ def prose(results: list[dict], plate: dict) -> str:
             f"to it (kirchhoff {ki:.3f}, filipov {fi:.3f} of Navier at the same m).",
             "2. **Poisson's ratio.** A hinge energy (one stiffness per dihedral angle) fixes the "
             "coefficient of the Gaussian-curvature term: on square cells it is the plate's with "
-            "ν = −1/3, whatever the sheet's ν. Where that term integrates to zero (every edge "
-            "supported along a straight line: Navier) the plate is exact; at free edges it is "
-            f"not: the plate free on two edges converges to {fe_bh / 1e3:.3f} kN/m against "
+            f"ν = {nu_eff:.3f} (the sheet's: {nu_s}). Where that term integrates to zero "
+            "(every edge supported along a straight line: Navier) the plate is exact; at free "
+            f"edges it is not: the plate free on two edges converges to {fe_bh / 1e3:.3f} kN/m "
+            "against "
             f"{fe_sh[nu] / 1e3:.3f} (shell, ν = {nu}) and {fe_sh['0'] / 1e3:.3f} (ν = 0), "
             f"{_pct(fe_bh / fe_sh[nu] - 1.0)} from the sheet's plate.",
-            "3. **Which cells pass.** The uniform-curvature patch test passes (residual 0) on "
-            "squares, rectangles up to aspect ratio ~1.6, the Miura parallelograms of these "
-            "roofs and equilateral triangles; elongated rectangles, the isosceles and right "
-            "triangles of the Yoshimura pattern and the trapezoids of the arched Miura fail it "
-            "(residual column), so those roofs converge to a plate of the wrong anisotropy: "
-            + ", ".join(f"{r['family']} {r['patch_residual']:.2f}" for r in bad)
-            + ".",
+            "3. **Which cells pass.** The uniform-curvature patch test passes on squares and "
+            "equilateral triangles (tested) and on the cells of "
+            + ", ".join(r["family"] for r in ok)
+            + (
+                "; it fails (residual / D in the table) on "
+                + ", ".join(f"{r['family']} {r['patch_residual']:.2f}" for r in bad)
+                + ": those roofs converge to a plate of the wrong anisotropy."
+                if bad
+                else "."
+            ),
             "4. **Roofs against the shell.** Limit of the consistent bar-and-hinge model "
             "(Richardson over m = 4, 8, 16) against the shell reference: "
             + "; ".join(gap(r) for r in results)
             + f". Within 5 %: {len(within)} of {len(results)} roofs"
             + (f" ({', '.join(r['family'] for r in within)})" if within else "")
-            + ". Passing cells: "
-            + ", ".join(r["family"] for r in ok)
             + ". Where the shell's own refinement has not converged (Miura roofs: its rate is "
             "below 1 and its extrapolation uncertain by tens of per cent) the comparison is "
             "open; where both converge (pleats) they converge to different limits.",
