@@ -16,7 +16,7 @@ import signal
 import sys
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any, Literal
 
 import typer
 from rich.console import Console
@@ -64,10 +64,11 @@ def _sigterm_as_interrupt() -> Iterator[None]:
 
 def _terminated(exc: BaseException) -> bool:
     """Whether ``exc`` (or what it was raised from) is a SIGTERM."""
-    while exc is not None:
-        if isinstance(exc, _Terminated):
+    link: BaseException | None = exc
+    while link is not None:
+        if isinstance(link, _Terminated):
             return True
-        exc = exc.__cause__ or exc.__context__
+        link = link.__cause__ or link.__context__
     return False
 
 
@@ -176,8 +177,8 @@ def patterns_cmd(
     """List the parametric pattern families, or generate one (``--out FILE.fold``)."""
     from rich.table import Table
 
+    from barhinge.families.spec import catalogue, family_kwargs, generate
     from barhinge.pattern.info import generated_info
-    from barhinge.patterns.spec import catalogue, family_kwargs, generate
 
     if name is None:
         data = catalogue()
@@ -248,7 +249,7 @@ def dof(
         )
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from barhinge.patterns.spec import read_or_generate
+    from barhinge.families.spec import read_or_generate
 
     cp = read_or_generate(pattern)
     bar = Progress(
@@ -385,13 +386,13 @@ def fold_cmd(
     from barhinge.output.run import picture_level, write_run
     from barhinge.results import Interrupted
     from barhinge.scene import default_scene, load_scene
-    from barhinge.solve.form import form_only_model, rigid_form
-    from barhinge.solve.newton import solve
+    from barhinge.solver.form import form_only_model, rigid_form
+    from barhinge.solver.newton import solve
 
     level = picture_level(pictures)  # a bad value stops before the solve
     scene = default_scene() if scene_file is None else load_scene(scene_file)
     check_output_folder(out, overwrite=overwrite)  # before the solve, not after
-    opts = {"overwrite": overwrite, "pictures": level, "viewer": viewer}
+    opts: dict[str, Any] = {"overwrite": overwrite, "pictures": level, "viewer": viewer}
     choice = None
     if accuracy is not None:
         from barhinge.analysis.accuracy import scene_for_accuracy
@@ -578,7 +579,9 @@ def study(
     from barhinge.sweep import SweepReport, load_study, run_study
 
     spec = load_study(study_file)
-    mode = "serial" if serial else ("dask" if scheduler else "local")
+    mode: Literal["serial", "local", "dask"] = (
+        "serial" if serial else ("dask" if scheduler else "local")
+    )
     progress = Progress(
         TextColumn("[bold]{task.description}"),
         BarColumn(),
@@ -653,7 +656,7 @@ def verify_cmd(
     from barhinge import verify
 
     if list_cases:  # the cases --case and --quick select, as a run would
-        data = {
+        data: dict[str, dict[str, Any]] = {
             c.name: {
                 "citation": c.citation,
                 "description": c.description,

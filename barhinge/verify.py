@@ -25,21 +25,21 @@ from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
-from barhinge import patterns
+from barhinge import families
 from barhinge.actuators import Actuators
 from barhinge.analysis.curvature import angle_defect, gaussian_curvature
 from barhinge.analysis.poisson import grid_pairs, periodic_poisson
 from barhinge.analysis.stiffness import effective_stiffness
 from barhinge.errors import ConfigError
+from barhinge.families.miura import miura_layout
+from barhinge.families.properties import maekawa_count
 from barhinge.kinematics.dof import dof
 from barhinge.kinematics.path import rigid_fold
 from barhinge.model.material import Material
 from barhinge.model.model import BarHingeModel
 from barhinge.pattern.crease import CreasePattern
-from barhinge.patterns.miura import miura_layout
-from barhinge.patterns.properties import maekawa_count
 from barhinge.scene import Scene
-from barhinge.solve.newton import solve
+from barhinge.solver.newton import solve
 
 __all__ = ["CASES", "Case", "Check", "Quantity", "run", "select", "summary"]
 
@@ -240,7 +240,7 @@ def _material():
 
 def _sg_closed_forms(a: float, b: float, gamma_deg: float, theta_deg: float) -> dict[str, float]:
     """Schenk & Guest (2013) PNAS 110(9):3276, Eq. 1-2, written out here (independently of
-    ``barhinge.patterns.miura_geometry``): cell height H, half width S, half length L,
+    ``barhinge.families.miura_geometry``): cell height H, half width S, half length L,
     zig-zag offset V, straight-crease fold angle and in-plane Poisson's ratio nu_SL."""
     g, th = math.radians(gamma_deg), math.radians(theta_deg)
     xi = math.sqrt(1.0 + math.cos(th) ** 2 * math.tan(g) ** 2)
@@ -256,7 +256,7 @@ def _sg_closed_forms(a: float, b: float, gamma_deg: float, theta_deg: float) -> 
 
 def _miura_dims(X: np.ndarray, ni: int) -> dict[str, float]:
     """Frame-independent H, S, L, V of the Miura cell at the corner of a grid-numbered sheet
-    (vertex (i, j) has id j * ni + i; see barhinge.patterns.miura)."""
+    (vertex (i, j) has id j * ni + i; see barhinge.families.miura)."""
 
     def v(i: int, j: int) -> np.ndarray:
         return X[j * ni + i]
@@ -287,7 +287,7 @@ def _miura_rigid() -> dict[str, float]:
     """Rigid path of one flat Miura cell, driven by its first interior zig-zag crease to
     -2 theta (the zig-zag fold angle of S&G's theta), then theta +- 0.05 deg for nu_SL."""
 
-    cp = patterns.miura(1, 1, a=_MA, b=_MB, alpha=_MG)
+    cp = families.miura(1, 1, a=_MA, b=_MB, alpha=_MG)
     lay = miura_layout(1, 1)
     ez = int(lay.interior_zigzag_edges[0])
     es = int(lay.interior_straight_edges[0])
@@ -347,7 +347,7 @@ def _miura_barhinge() -> dict[str, float]:
     """Bar-and-hinge (N5B8) model of the same cell, bars and bending stiffened 1000x relative
     to the folds, folded by fold-angle control of the same zig-zag crease."""
 
-    cp = patterns.miura(1, 1, a=_MA, b=_MB, alpha=_MG)
+    cp = families.miura(1, 1, a=_MA, b=_MB, alpha=_MG)
     lay = miura_layout(1, 1)
     ez = int(lay.interior_zigzag_edges[0])
     sign = math.copysign(1.0, float(cp.fold_angles[ez]))
@@ -375,7 +375,7 @@ _miura_bh_case = Case(
 )
 
 # 3 x 3 Miura sheet (a = b = 1, gamma = 60 deg) folded from flat to half its pattern target:
-# the zig-zag creases' target is 2 x 60 deg (patterns.miura's default theta), half of it
+# the zig-zag creases' target is 2 x 60 deg (families.miura's default theta), half of it
 # is S&G's theta = 30 deg.
 _FS_N, _FS_THETA, _FS_RATIOS, _FS_STEPS = 3, 30.0, (1e4, 1e5), 6
 _FS_SG = _sg_closed_forms(1.0, 1.0, _MG, _FS_THETA)
@@ -401,8 +401,8 @@ def _multi_cell_flat_start(flat_start: str = "rigid") -> dict[str, float]:
     farthest from the rigid closed forms; the observed order of the gap between the two
     ratios. ``flat_start`` is the solver option (the tests show "tangent" fails the case)."""
 
-    cp = patterns.miura(_FS_N, _FS_N, alpha=_MG)
-    lay = patterns.miura_layout(_FS_N, _FS_N)
+    cp = families.miura(_FS_N, _FS_N, alpha=_MG)
+    lay = families.miura_layout(_FS_N, _FS_N)
     ez = int(lay.interior_zigzag_edges[0])
     target = 0.5 * float(cp.fold_angles[ez])
     if abs(abs(target) - 2 * _FS_THETA) > 1e-9:
@@ -557,7 +557,7 @@ def _maekawa_kawasaki() -> dict[str, float]:
     Miura (gamma = 60 deg) and Yoshimura sheets; the worst vertex is reported."""
 
     m, kw = [], []
-    for cp in (patterns.miura(2, 2, alpha=_MG), patterns.yoshimura(4, 2)):
+    for cp in (families.miura(2, 2, alpha=_MG), families.yoshimura(4, 2)):
         m.extend(np.abs(maekawa_count(cp)[cp.interior_vertices]).tolist())
         for v in cp.interior_vertices:
             sec = np.asarray(cp.sector_angles[v])
@@ -638,7 +638,7 @@ _curvature_case = Case(
 
 def _dof() -> dict[str, float]:
 
-    cp = patterns.miura(3, 3, alpha=_MG)
+    cp = families.miura(3, 3, alpha=_MG)
     rep = dof(cp)
     fold = rep.folded if rep.folded is not None else rep
     n_e = int(np.isin(cp.assignment, ["M", "V"]).sum())
@@ -940,7 +940,7 @@ def _periodic_miura() -> dict[str, float]:
 
     g = _SG
     T = [[2 * g["L"], 0.0, 0.0], [0.0, 2 * g["S"], 0.0]]
-    cp = patterns.miura(2, 2, a=_MA, b=_MB, alpha=_MG, fold=_MT)
+    cp = families.miura(2, 2, a=_MA, b=_MB, alpha=_MG, fold=_MT)
     rigid = BarHingeModel.from_pattern(cp, "N5B8", material=_material(), stiffness_ratio=1e6)
     iso = BarHingeModel.from_pattern(cp, "N5B8", material=_material(), stiffness_ratio=1e3)
     iso = iso.with_(bar_EA=iso.bar_EA * 1e6)
@@ -985,7 +985,7 @@ def _end_to_end(n: int) -> float:
     from barhinge.analysis.poisson import end_to_end_poisson, grid_ends
 
     th0 = math.degrees(math.acos(1.0 / math.tan(math.radians(_MG))))
-    cp = patterns.miura(n, n, alpha=_MG)
+    cp = families.miura(n, n, alpha=_MG)
     lay = miura_layout(n, n)
     ez = int(lay.interior_zigzag_edges[0])
     sign = math.copysign(1.0, float(cp.fold_angles[ez]))
@@ -1109,7 +1109,7 @@ def _kresling_ref() -> dict[str, float]:
 
 
 def _kresling() -> dict[str, float]:
-    """Bar-and-hinge Kresling tower (patterns.kresling(fold=1), one story, EA = 1, fold
+    """Bar-and-hinge Kresling tower (families.kresling(fold=1), one story, EA = 1, fold
     stiffness 0), bottom polygon fixed: (1) displacement control of the top polygon's height
     from the tall to the short stable state in 20 steps; (2) arc-length control under an
     axial load of 1.2x the truss model's largest compressive force, past the limit point."""
@@ -1118,7 +1118,7 @@ def _kresling() -> dict[str, float]:
     n = _KN
     cf = _kresling_closed_form()
     ref = _kresling_ref()
-    cp = patterns.kresling(n, 1, height=_KH, shift=_KS, fold=1)
+    cp = families.kresling(n, 1, height=_KH, shift=_KS, fold=1)
     model = BarHingeModel.from_pattern(cp, "N4B5", bar_EA=1.0, fold_k=0.0)
     sup = np.zeros((model.n_nodes, 3), bool)
     sup[:n] = True

@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def miura_path(n: int, states: int = 30):
-    from barhinge.patterns import miura
+    from barhinge.families import miura
     from barhinge.results import FoldPath
 
     thetas = np.linspace(5.0, 60.0, states)

@@ -280,7 +280,7 @@ def choose_model(
     ConvergenceError
         No candidate up to ``max_m`` meets the accuracy; the message names the best estimate.
     """
-    from barhinge.solve.form import form_only_model
+    from barhinge.solver.form import form_only_model
 
     acc = parse_accuracy(accuracy)
     outs = tuple(outputs)
@@ -358,8 +358,8 @@ def _choose_actuated(scene, acc: float, outs: tuple[str, ...]) -> ModelChoice:
     the rigid form's error = largest fold-angle difference at the end of the path over the
     largest fold angle, from a coarse bar-and-hinge solve (``ESTIMATE_STEPS`` steps)."""
     from barhinge.errors import BarhingeError
-    from barhinge.solve.form import rigid_form
-    from barhinge.solve.newton import solve
+    from barhinge.solver.form import rigid_form
+    from barhinge.solver.newton import solve
 
     if any(o != "form" for o in outs):
         raise ConfigError(
@@ -387,7 +387,7 @@ def scene_for_accuracy(scene, accuracy: float | str, outputs: tuple[str, ...] | 
     """(scene to run, ModelChoice): the scene rebuilt on the model :func:`choose_model` picks
     (the scene itself for the rigid form or the scene's own model). ``outputs`` default:
     the form for a scene driven by actuators alone, else the stiffness."""
-    from barhinge.solve.form import form_only_model
+    from barhinge.solver.form import form_only_model
 
     if not outputs:
         outputs = ("form",) if form_only_model(scene)[0] == "rigid" else ("stiffness",)

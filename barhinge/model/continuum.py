@@ -26,6 +26,8 @@ Meshes are small (a few hundred elements) so the tests stay fast. Whole-panel co
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
@@ -35,6 +37,7 @@ from barhinge.model.material import Material
 
 __all__ = [
     "polygon_mesh",
+    "morley_plate_matrix",
     "membrane_energy",
     "membrane_edge_load",
     "plate_corner_energy",
@@ -158,15 +161,27 @@ def membrane_edge_load(
     return 2.0 * _solve_prescribed(K, np.concatenate([Dx, Dy]), np.concatenate([ux, uy]))
 
 
-def plate_corner_energy(
-    P: np.ndarray, material: Material, corner_w: np.ndarray, refine: int = 4
-) -> float:
-    """Kirchhoff-plate (Morley) energy of the polygon ``P`` (k, 2) with the deflection
-    prescribed at the k corners only (all edges free)."""
+def morley_plate_matrix(mesh: Any, material: Material) -> tuple[Any, Any]:
+    """Kirchhoff-plate stiffness on Morley's constant-moment triangle over a triangle mesh.
+
+    Parameters
+    ----------
+    mesh : skfem.MeshTri
+        For a polygon: :func:`polygon_mesh` (its first nodes are the polygon's corners).
+    material : Material
+
+    Returns
+    -------
+    K : scipy.sparse matrix
+        Stiffness of the deflection dofs, bending rigidity ``D = E t^3 / (12 (1 - nu^2))`` of
+        ``material`` (energy in the user's units).
+    basis : skfem.Basis
+        Its basis; for a :func:`polygon_mesh`, ``basis.nodal_dofs[0, :k]`` are the deflections
+        of the k corners.
+    """
     from skfem import Basis, BilinearForm, ElementTriMorley, asm
     from skfem.helpers import dd, ddot, trace
 
-    mesh = polygon_mesh(P, refine)
     basis = Basis(mesh, ElementTriMorley())
     Dp, nu = material.bending_rigidity, material.nu
 
@@ -174,9 +189,16 @@ def plate_corner_energy(
     def plate(u, v, w):
         return Dp * ((1.0 - nu) * ddot(dd(u), dd(v)) + nu * trace(dd(u)) * trace(dd(v)))
 
-    K = asm(plate, basis)
-    k = len(P)
-    D = basis.nodal_dofs[0, :k]
+    return asm(plate, basis), basis
+
+
+def plate_corner_energy(
+    P: np.ndarray, material: Material, corner_w: np.ndarray, refine: int = 4
+) -> float:
+    """Kirchhoff-plate (Morley) energy of the polygon ``P`` (k, 2) with the deflection
+    prescribed at the k corners only (all edges free)."""
+    K, basis = morley_plate_matrix(polygon_mesh(P, refine), material)
+    D = basis.nodal_dofs[0, : len(P)]
     return _solve_prescribed(K, D, np.asarray(corner_w, dtype=float))
 
 
@@ -195,18 +217,7 @@ def _condensed(K: sp.spmatrix, keep: np.ndarray, drop: np.ndarray) -> np.ndarray
 def plate_corner_stiffness(P: np.ndarray, material: Material, refine: int = 4) -> np.ndarray:
     """(k, k) Kirchhoff-plate (Morley) stiffness of the polygon ``P`` condensed to the
     deflections of its k corners (edges free)."""
-    from skfem import Basis, BilinearForm, ElementTriMorley, asm
-    from skfem.helpers import dd, ddot, trace
-
-    mesh = polygon_mesh(P, refine)
-    basis = Basis(mesh, ElementTriMorley())
-    Dp, nu = material.bending_rigidity, material.nu
-
-    @BilinearForm
-    def plate(u, v, w):
-        return Dp * ((1.0 - nu) * ddot(dd(u), dd(v)) + nu * trace(dd(u)) * trace(dd(v)))
-
-    K = asm(plate, basis)
+    K, basis = morley_plate_matrix(polygon_mesh(P, refine), material)
     keep = basis.nodal_dofs[0, : len(P)]
     drop = np.setdiff1d(np.arange(K.shape[0]), keep)
     return _condensed(K, keep, drop)

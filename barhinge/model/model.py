@@ -59,7 +59,10 @@ FOLD_LAWS = ("linear", "penetration")
 _r6, _c6 = np.triu_indices(6)
 _SYM3 = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)]
 _BAR_Q = np.array(
-    [_SYM3.index((min(a % 3, b % 3), max(a % 3, b % 3))) for a, b in zip(_r6, _c6, strict=True)]
+    [
+        _SYM3.index((min(int(a) % 3, int(b) % 3), max(int(a) % 3, int(b) % 3)))
+        for a, b in zip(_r6, _c6, strict=True)
+    ]
 )
 _BAR_SIGN = np.where((_r6 < 3) == (_c6 < 3), 1.0, -1.0)
 _BAR_FIRST = [int(np.flatnonzero((_BAR_Q == q) & (_BAR_SIGN > 0))[0]) for q in range(6)]
@@ -502,7 +505,7 @@ def _override(current: np.ndarray, value: Any, n: int, name: str) -> np.ndarray:
 
 
 def plate_bend_scale(
-    cp: CreasePattern, scheme: str, material: Material, faces: np.ndarray, refine: int = 4
+    cp: CreasePattern, scheme: Scheme, material: Material, faces: np.ndarray, refine: int = 4
 ) -> np.ndarray:
     """(len(faces),) factor for the ``"kirchhoff"`` bending stiffnesses of each face so that
     the panel's corner-warping stiffness equals a Kirchhoff plate's (Morley elements,
@@ -527,7 +530,10 @@ def plate_bend_scale(
         for u, f in enumerate(first):
             Qf = Q[f]
             panel = CreasePattern(
-                Qf, [[i, (i + 1) % k] for i in range(k)], ["B"] * k, faces=[list(range(k))]
+                Qf,
+                np.array([[i, (i + 1) % k] for i in range(k)]),
+                np.array(["B"] * k),
+                faces=[list(range(k))],
             )
             m = BarHingeModel.from_pattern(
                 panel, scheme, material, bend_calibration="kirchhoff", fold_stiffness=0.0

@@ -20,7 +20,7 @@ from barhinge.analysis.accuracy import (
 )
 from barhinge.errors import ConfigError
 from barhinge.scene import Scene, default_scene
-from barhinge.solve.form import rigid_form
+from barhinge.solver.form import rigid_form
 
 MAT = bh.Material(E=70e9, nu=0.33, t=2e-3)
 
@@ -45,7 +45,7 @@ def test_richardson_recovers_a_power_law():
 def _roof(fold: float = 50.0) -> Scene:
     """A 2 x 2 Miura sheet pinned along its two y-ends under a downward load on every
     vertex (the same nodal loads at every subdivision level)."""
-    cp = bh.patterns.miura(nx=2, ny=2, fold=fold)
+    cp = bh.families.miura(nx=2, ny=2, fold=fold)
     model = bh.BarHingeModel.from_pattern(cp, "N5B8", MAT)
     V = np.asarray(cp.vertices3d)
     y = V[:, 1]

@@ -88,7 +88,7 @@ def test_elongated_cells_fail_the_patch_test_and_converge_elsewhere():
 
 
 def test_creases_in_series_with_the_plate_strip_and_n4b5_is_refused():
-    cp = bh.patterns.miura(nx=2, ny=2, fold=40.0)
+    cp = bh.families.miura(nx=2, ny=2, fold=40.0)
     model = bh.BarHingeModel.from_pattern(subdivided(cp, 2)[0], "N5B8", MAT)
     ph = consistent_hinge_stiffness(model)
     asg = np.asarray(model.pattern.assignment)[np.maximum(model.hinge_edge, 0)]

@@ -52,7 +52,7 @@ def test_n4b5_splits_along_the_shorter_diagonal() -> None:
 
 def test_miura_counts_and_bookkeeping() -> None:
     nx, ny = 3, 2
-    cp = bh.patterns.miura(nx, ny, fold=30.0)
+    cp = bh.families.miura(nx, ny, fold=30.0)
     nf = cp.n_faces
     n_crease = len(cp.crease_edges)
     for scheme, extra_nodes, bars_per_face, bend_per_face in (("N4B5", 0, 1, 1), ("N5B8", 1, 4, 4)):
@@ -95,7 +95,7 @@ def test_nonplanar_quad_n5b8_rest_angles_take_the_state() -> None:
 
 
 def test_stiffness_defaults_overrides_and_ratio() -> None:
-    cp = bh.patterns.miura(2, 2)
+    cp = bh.families.miura(2, 2)
     mat = Material(E=2e9, nu=0.3, t=1e-3)
     D = mat.bending_rigidity
     m = BarHingeModel.from_pattern(cp, "N5B8", mat, crease_length_scale=0.05)
@@ -138,7 +138,7 @@ def test_stiffness_defaults_overrides_and_ratio() -> None:
 )
 def test_bad_options_raise_config_error(kwargs: dict) -> None:
     with pytest.raises(ConfigError):
-        BarHingeModel.from_pattern(bh.patterns.miura(1, 1), **kwargs)
+        BarHingeModel.from_pattern(bh.families.miura(1, 1), **kwargs)
 
 
 def test_bad_material_and_coordinates() -> None:
@@ -146,7 +146,7 @@ def test_bad_material_and_coordinates() -> None:
         Material(E=-1.0)
     with pytest.raises(ConfigError):
         Material(nu=0.6)
-    m = BarHingeModel.from_pattern(bh.patterns.miura(1, 1))
+    m = BarHingeModel.from_pattern(bh.families.miura(1, 1))
     with pytest.raises(ConfigError):
         m.evaluate(np.zeros((3, 3)))
 

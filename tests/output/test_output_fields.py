@@ -126,8 +126,8 @@ def test_model_state_arrays_against_direct_formulas():
     angles on crease bars equal the model's hinge angles."""
     bh = pytest.importorskip("barhinge")
     pytest.importorskip("barhinge.model.model")
-    pytest.importorskip("barhinge.patterns")
-    cp = bh.patterns.miura(2, 2, fold=40.0)
+    pytest.importorskip("barhinge.families")
+    cp = bh.families.miura(2, 2, fold=40.0)
     model = bh.BarHingeModel.from_pattern(cp, material=bh.Material(E=1e3, nu=0.3, t=0.01))
     rng = np.random.default_rng(1)
     X = model.X0 + 1e-3 * rng.normal(size=model.X0.shape)
@@ -150,7 +150,7 @@ def test_write_results_of_a_bar_hinge_path(tmp_path):
     the summary; the energy densities integrate to the model's energy split."""
     bh = pytest.importorskip("barhinge")
     pytest.importorskip("barhinge.model.model")
-    patterns = pytest.importorskip("barhinge.patterns")
+    patterns = pytest.importorskip("barhinge.families")
     cp = patterns.miura(2, 2, fold=30.0)
     model = bh.BarHingeModel.from_pattern(cp, material=bh.Material(E=1e3, nu=0.3, t=0.01))
     rng = np.random.default_rng(3)
@@ -194,10 +194,11 @@ def test_vtu_force_fields_match_the_strains_and_fold_angles(tmp_path):
     import meshio
 
     import barhinge as bh
+    from barhinge.families import miura_line_creases
     from barhinge.output.fields import write_state_vtu
-    from barhinge.scene import Scene, miura_line_creases
+    from barhinge.scene import Scene
 
-    cp = bh.patterns.miura(2, 2, fold=20.0)
+    cp = bh.families.miura(2, 2, fold=20.0)
     model = bh.BarHingeModel.from_pattern(cp, material=bh.Material(E=1e3, nu=0.3, t=0.01))
     edges = miura_line_creases(cp)
     acts = bh.Actuators(edges=edges, targets_deg=np.asarray(cp.fold_angles)[edges] * 1.5)

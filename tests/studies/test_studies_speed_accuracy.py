@@ -2,7 +2,7 @@
 
 References: Schenk & Guest (2013), "Geometry of Miura-folded metamaterials", PNAS 110(9):
 3276-3281, Eq. 1 (cell dimensions) and Eq. 2 (nu_SL = -cos^2(theta) tan^2(gamma)); the
-closed-form rigidly folded Yoshimura arch of ``bh.patterns.yoshimura(fold=...)``.
+closed-form rigidly folded Yoshimura arch of ``bh.families.yoshimura(fold=...)``.
 """
 
 from __future__ import annotations
