@@ -240,6 +240,53 @@ def free_edge_plate(levels_bh: list[int], levels_shell: list[int]) -> dict:
     return out
 
 
+def poisson_check(levels_bh: list[int], levels_shell: list[int]) -> dict:
+    """The pleats roof with monolithic creases (stiff fold springs, 1e6 N·m/rad per m) in both
+    models, with the sheet's nu and with nu = 0: stiffness per level and Richardson limits.
+    The hinge energy's Gaussian-curvature coefficient is fixed (module plate_hinges), so the
+    gap between the converged models should shrink with the distance of nu from it."""
+    import barhinge as bh
+    from barhinge.analysis.stiffness import linear_response
+    from barhinge.model.plate_hinges import consistent_hinge_stiffness
+    from barhinge.model.shell import shell_model
+    from barhinge.pattern.subdivide import subdivided
+
+    kc = 1e6
+    cp, flat_xy, _ = roofs.folded("pleats", 90.0)
+    sv, se = support_sets(cp, flat_xy, roofs.FAMILIES["pleats"]["axis"])
+    out: dict = {}
+    for nu in (roofs.MATERIAL["nu"], 0.0):
+        mat = bh.Material(E=roofs.MATERIAL["E"], nu=nu, t=roofs.MATERIAL["t"])
+        bh_k = []
+        for m in levels_bh:
+            cpm, parent = subdivided(cp, m)
+            model = bh.BarHingeModel.from_pattern(
+                cpm, "N5B8", mat, bend_calibration="kirchhoff", fold_stiffness=kc
+            )
+            model = model.with_(hinge_k=consistent_hinge_stiffness(model).hinge_k)
+            S = np.zeros((model.n_nodes, 3), bool)
+            S[np.union1d(sv, np.flatnonzero(np.isin(parent, se)))] = True
+            F = roofs.plan_load(model, roofs.Q)
+            U, _ = linear_response(model, F, S)
+            bh_k.append(float(F[:, 2].sum() ** 2 / np.sum(F * U)))
+        sh_k = []
+        for r in levels_shell:
+            sh = shell_model(cp, mat, r, crease_stiffness=kc)
+            f = sh.surface_load((0.0, 0.0, -roofs.Q), per="plan")
+            u = sh.solve(f, np.union1d(sh.nodes_on_edges(se), sv))
+            Qt = float(-sh.translations(f)[:, 2].sum())
+            sh_k.append(Qt**2 / float(f @ u))
+        out[f"{nu:g}"] = {
+            "m": levels_bh,
+            "r": levels_shell,
+            "bar_hinge": bh_k,
+            "shell": sh_k,
+            "bar_hinge_limit": extrapolate(bh_k)[0],
+            "shell_limit": extrapolate(sh_k)[0],
+        }
+    return out
+
+
 def extrapolate(k: list[float]) -> tuple[float, float, float]:
     """(reference, observed rate p in h, uncertainty) from values on levels h, h/2, h/4...:
     Richardson with ``p = log2(d1 / d2)`` of the last two differences when they shrink
@@ -312,14 +359,35 @@ def run() -> list[dict]:
 CACHE = next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--cache=")), None)
 if CACHE and Path(CACHE).exists():
     RESULTS, PLATE = json.loads(Path(CACHE).read_text())
+    if "poisson" not in PLATE:
+        PLATE["poisson"] = poisson_check([4, 8, 16], [2, 3, 4])
+        Path(CACHE).write_text(json.dumps([RESULTS, PLATE]))
 else:
     RESULTS = run()
     PLATE = flat_plate([2, 4] if QUICK else [2, 4, 8, 16], [2, 3] if QUICK else [2, 3, 4, 5])
     PLATE["free_edge"] = free_edge_plate(
         [4, 8] if QUICK else [8, 16, 32], [2, 3] if QUICK else [3, 4, 5]
     )
+    PLATE["poisson"] = poisson_check(
+        [2, 4] if QUICK else [4, 8, 16], [1, 2] if QUICK else [2, 3, 4]
+    )
     if CACHE:
         Path(CACHE).write_text(json.dumps([RESULTS, PLATE]))
+
+
+def poisson_table(pc: dict) -> str:
+    lines = [
+        "| ν | model | levels | stiffness per level (kN/m) | limit (kN/m) |",
+        "|---|---|---|---|---|",
+    ]
+    for nu, d in pc.items():
+        for name, lv, key in (("bar-hinge, consistent", "m", "bar_hinge"), ("shell", "r", "shell")):
+            vals = ", ".join(f"{k / 1e3:.1f}" for k in d[key])
+            levels = ", ".join(str(x) for x in d[lv])
+            lines.append(
+                f"| {nu} | {name} | {lv} = {levels} | {vals} | {d[key + '_limit'] / 1e3:.1f} |"
+            )
+    return "\n".join(lines)
 
 
 def _pct(x: float) -> str:
@@ -489,6 +557,17 @@ def prose(results: list[dict], plate: dict) -> str:
             + ". Where the shell's own refinement has not converged (Miura roofs: its rate is "
             "below 1 and its extrapolation uncertain by tens of per cent) the comparison is "
             "open; where both converge (pleats) they converge to different limits.",
+            "5. **Why the converged pleats differ.** With monolithic creases (table above) the "
+            "gap between the two converged models is "
+            + ", ".join(
+                f"{_pct(d['bar_hinge_limit'] / d['shell_limit'] - 1.0)} at ν = {nu}"
+                for nu, d in plate["poisson"].items()
+            )
+            + ": it shrinks as the sheet's ν approaches the hinge energy's own coefficient, "
+            "so the larger part of it is the Gaussian-curvature term, which does not integrate to zero "
+            "on panels whose edges are creases. A dihedral-angle energy with one stiffness per "
+            "hinge cannot carry the plate's ν; coupling the angles of a cell (a per-cell "
+            "curvature from its hinge angles) would.",
         ]
     )
 
@@ -571,6 +650,11 @@ def section(results: list[dict]) -> str:
             " sheet's ν and with ν = 0, the beam strip):",
             "",
             free_edge_table(PLATE["free_edge"]),
+            "",
+            "The pleats roof with monolithic creases (fold springs 1e6 N·m/rad per m) in both"
+            " models, with the sheet's ν and with ν = 0:",
+            "",
+            poisson_table(PLATE["poisson"]),
             "",
             prose(results, PLATE),
             "",
