@@ -564,7 +564,8 @@ def prose(results: list[dict], plate: dict) -> str:
                 for nu, d in plate["poisson"].items()
             )
             + ": it shrinks as the sheet's ν approaches the hinge energy's own coefficient, "
-            "so the larger part of it is the Gaussian-curvature term, which does not integrate to zero "
+            "so the larger part of it is the Gaussian-curvature term, which does not integrate "
+            "to zero "
             "on panels whose edges are creases. A dihedral-angle energy with one stiffness per "
             "hinge cannot carry the plate's ν; coupling the angles of a cell (a per-cell "
             "curvature from its hinge angles) would.",
