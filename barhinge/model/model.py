@@ -549,7 +549,14 @@ def plate_bend_scale(
             )
             Sb = panel_corner_stiffness(m, np.arange(k))
             Sp = plate_corner_stiffness(Qf, material, refine)
-            vals[u] = float(np.trace(Sp) / np.trace(Sb)) if np.trace(Sb) > 0 else 1.0
+            tb, tp = float(np.trace(Sb)), float(np.trace(Sp))
+            if not (np.isfinite(tb) and np.isfinite(tp) and tb > 0.0 and tp > 0.0):
+                raise ConfigError(
+                    f"bend_calibration='plate': face {int(faces[sel][f])} has no finite "
+                    "corner-warping stiffness (degenerate panel); use bend_calibration="
+                    "'kirchhoff' or 'filipov'"
+                )
+            vals[u] = tp / tb
         out[sel] = vals[inv.ravel()]
     logger.debug("plate bending calibration: %d faces", len(faces))
     return out
