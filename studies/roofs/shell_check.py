@@ -42,7 +42,7 @@ DOC = ROOT / "docs" / "roofs.md"
 START, END = "<!-- shell_check:start -->", "<!-- shell_check:end -->"
 
 #: bar-and-hinge variants: name -> BarHingeModel.from_pattern keywords
-VARIANTS = {"filipov": {}, "kirchhoff": {"bend_calibration": "kirchhoff"}}
+VARIANTS = {"plate": {}, "kirchhoff": {"bend_calibration": "kirchhoff"}}
 
 if QUICK:
     ROOFS = [("pleats", 90.0)]
@@ -76,7 +76,7 @@ def crease_stiffness_per_length(model) -> float:
     return float(k[0])
 
 
-def bar_hinge(cp, sv, se, m: int, variant: str = "filipov") -> dict:
+def bar_hinge(cp, sv, se, m: int, variant: str = "plate") -> dict:
     """Stiffness of the bar-and-hinge roof with m x m sub-panels (``VARIANTS[variant]``
     calibration)."""
     import barhinge as bh
@@ -189,7 +189,7 @@ def run() -> list[dict]:
         cp, flat_xy, _ = roofs.folded(fam, state)
         sv, se = support_sets(cp, flat_xy, roofs.FAMILIES[fam]["axis"])
         bhr = {v: [bar_hinge(cp, sv, se, m, v) for m in BH_LEVELS] for v in VARIANTS}
-        ck = bhr["filipov"][0]["crease_k"]
+        ck = bhr["plate"][0]["crease_k"]
         shr = [shell(cp, sv, se, r, ck) for r in SHELL_LEVELS]
         ref, p, unc = extrapolate([s["stiffness"] for s in shr])
         ms = np.array(BH_LEVELS, float)
@@ -269,7 +269,7 @@ def plate_table(plate: dict) -> str:
 
 
 def section(results: list[dict]) -> str:
-    ck = results[0]["bar_hinge"]["filipov"][0]["crease_k"]
+    ck = results[0]["bar_hinge"]["plate"][0]["crease_k"]
     return "\n".join(
         [
             START,
@@ -278,7 +278,7 @@ def section(results: list[dict]) -> str:
             " squared over the compliance, linear, under 1 kN/m² (no self-weight). Creases in both"
             f" models have the fold stiffness {ck:.1f} N·m/rad per metre of crease. Error ="
             " bar-and-hinge stiffness / shell reference − 1 for m × m sub-panels per panel, with"
-            " the study's bending calibration (filipov) and the refinement-consistent"
+            " the study's bending calibration (plate) and the refinement-consistent"
             " kirchhoff one; rate = slope of log |error|"
             " against log m; shell rate = observed order in the"
             " element size of the shell's own refinement (r: 2^r elements per facet edge).",
