@@ -20,7 +20,8 @@ def _against(cp, fold_deg, min_deg=1e-6):
 def test_readme_example_folds_with_the_assignment():
     """The README's Python example, started flat exactly as written: every crease folds with
     its assignment's sign, nearly all the energy is in the folds (panels + bars < 1 % at
-    stiffness ratio 1e5; ~1/r, 2.9 % at 1e4 with the plate-calibrated panel bending), and the actuator reaches its target."""
+    stiffness ratio 1e5; ~1/r, 2.9 % at 1e4 with the plate-calibrated panel bending), and the
+    actuator reaches its target."""
     cp = bh.families.miura(nx=4, ny=4, a=1.0, b=1.0, alpha=60.0)
     a = bh.dof(cp).mechanism.actuators
     model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=MAT, stiffness_ratio=1e5)
