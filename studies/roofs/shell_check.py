@@ -44,7 +44,7 @@ START, END = "<!-- shell_check:start -->", "<!-- shell_check:end -->"
 
 #: bar-and-hinge variants: name -> BarHingeModel.from_pattern keywords
 VARIANTS = {
-    "filipov": {},
+    "plate": {},
     "kirchhoff": {"bend_calibration": "kirchhoff"},
     "consistent": {"bend_calibration": "kirchhoff"},
 }
@@ -64,7 +64,7 @@ else:
         ("miura_arc", 60.0),
     ]
     BH_LEVELS, SHELL_LEVELS = [1, 2, 4, 8, 16], [1, 2, 3, 4]
-    LEVELS = {"filipov": [1, 2, 4, 8], "kirchhoff": [1, 2, 4, 8], "consistent": BH_LEVELS}
+    LEVELS = {"plate": [1, 2, 4, 8], "kirchhoff": [1, 2, 4, 8], "consistent": BH_LEVELS}
 
 
 def support_sets(cp, flat_xy: np.ndarray, axis: int) -> tuple[np.ndarray, np.ndarray]:
@@ -91,7 +91,7 @@ def crease_stiffness_per_length(model) -> float:
     return float(k[0])
 
 
-def bar_hinge(cp, sv, se, m: int, variant: str = "filipov", scheme: str = "N5B8") -> dict:
+def bar_hinge(cp, sv, se, m: int, variant: str = "plate", scheme: str = "N5B8") -> dict:
     """Stiffness of the bar-and-hinge roof with m x m sub-panels (``VARIANTS[variant]``
     calibration)."""
     import barhinge as bh
@@ -315,8 +315,8 @@ def run() -> list[dict]:
         cp, flat_xy, _ = roofs.folded(fam, state)
         sv, se = support_sets(cp, flat_xy, roofs.FAMILIES[fam]["axis"])
         bhr = {v: [bar_hinge(cp, sv, se, m, v) for m in LEVELS[v]] for v in VARIANTS}
-        n4b5 = bar_hinge(cp, sv, se, 1, "filipov", scheme="N4B5")
-        ck = bhr["filipov"][0]["crease_k"]
+        n4b5 = bar_hinge(cp, sv, se, 1, "plate", scheme="N4B5")
+        ck = bhr["plate"][0]["crease_k"]
         shr = [shell(cp, sv, se, r, ck) for r in SHELL_LEVELS]
         ref, p, unc = extrapolate([s["stiffness"] for s in shr])
         errors, rates = {}, {}
@@ -446,7 +446,7 @@ def timing(results: list[dict]) -> str:
     for r in results:
         b = r["n4b5"]
         lines.append(
-            f"| {r['family']} | bar-hinge N4B5, filipov | m = 1 | {b['n_dof']} | "
+            f"| {r['family']} | bar-hinge N4B5, plate | m = 1 | {b['n_dof']} | "
             f"{b['stiffness'] / 1e3:.1f} | {b['time_s']:.2f} |"
         )
         for v, rows in r["bar_hinge"].items():
@@ -500,7 +500,7 @@ def prose(results: list[dict], plate: dict) -> str:
     """The findings, with the numbers of this run."""
     p_rate, p_err = plate_rate(plate["bar_hinge"]["consistent"])
     ki = plate["bar_hinge"]["kirchhoff"][-1]["ratio"]
-    fi = plate["bar_hinge"]["filipov"][-1]["ratio"]
+    fi = plate["bar_hinge"]["plate"][-1]["ratio"]
     fe = plate["free_edge"]
     fe_bh = extrapolate([b["stiffness"] for b in fe["bar_hinge"]])[0]
     fe_sh = {
@@ -530,7 +530,7 @@ def prose(results: list[dict], plate: dict) -> str:
             "1. **Flat plate.** With the consistent rule the subdivided panel converges to "
             f"Navier's plate at order {p_rate:.2f} in m ({_pct(p_err)} at m = "
             f"{plate['bar_hinge']['consistent'][-1]['m']}); the per-panel rules do not converge "
-            f"to it (kirchhoff {ki:.3f}, filipov {fi:.3f} of Navier at the same m).",
+            f"to it (kirchhoff {ki:.3f}, plate {fi:.3f} of Navier at the same m).",
             "2. **Poisson's ratio.** A hinge energy (one stiffness per dihedral angle) fixes the "
             "coefficient of the Gaussian-curvature term: on square cells it is the plate's with "
             f"ν = {nu_eff:.3f} (the sheet's: {nu_s}). Where that term integrates to zero "
@@ -611,7 +611,7 @@ def chart(results: list[dict], path: Path) -> None:
 
 
 def section(results: list[dict]) -> str:
-    ck = results[0]["bar_hinge"]["filipov"][0]["crease_k"]
+    ck = results[0]["bar_hinge"]["plate"][0]["crease_k"]
     return "\n".join(
         [
             START,
@@ -620,7 +620,7 @@ def section(results: list[dict]) -> str:
             " squared over the compliance, linear, under 1 kN/m² (no self-weight). Creases in both"
             f" models have the fold stiffness {ck:.1f} N·m/rad per metre of crease. Error ="
             " bar-and-hinge stiffness / shell reference − 1 for m × m sub-panels per panel, with"
-            " the study's bending calibration (filipov), the kirchhoff one, and the"
+            " the study's bending calibration (plate, the default), the kirchhoff one, and the"
             " plate-consistent rule (`barhinge.model.plate_hinges`: every hinge inside or"
             " between cells chosen so that each cell stores the plate energy of every uniform"
             " curvature, creases in series with the plate strip beside them); rate = slope of"
