@@ -115,3 +115,25 @@ def test_ear_clipped_mesh_gives_the_fan_mesh_energy() -> None:
     want = _quad_plate_energy(P, mat, WARP)
     assert fan == pytest.approx(want, rel=1e-10)
     assert ear == pytest.approx(want, rel=1e-10)
+
+
+@pytest.mark.parametrize(
+    "P,tol",
+    [
+        ([[0, 0], [2, 0], [1.5, 1], [0.5, 1]], 1e-3),  # trapezoid: smooth, second order
+        ([[0, 0], [1.3, 0.1], [1.1, 0.9], [0.2, 1.4]], 1e-3),  # generic convex quad
+        ([[0, 0], [2, 0], [1, 0.3], [1, 2]], 3e-2),  # dart: reflex corner, first order
+    ],
+)
+def test_plate_reference_at_the_default_refinement(P, tol: float) -> None:
+    """Quadrilaterals other than parallelograms have no polynomial plate solution: the
+    default rule matches the Morley plate at ``refine=4``, which is within ``tol`` of the
+    refinement limit (Richardson extrapolation of refine 3, 4, 5 at the observed rate)."""
+    mat = Material(E=1.0, nu=0.3, t=0.01)
+    Q = np.array(P, float)
+    tr = np.array([np.trace(cont.plate_corner_stiffness(Q, mat, r)) for r in (3, 4, 5)])
+    d = np.diff(tr)
+    assert d[0] > 0 and d[1] > 0  # monotone from below (Morley is soft here)
+    rate = np.log2(d[0] / d[1])
+    limit = tr[2] + d[1] / (2.0**rate - 1.0)
+    assert abs(tr[1] / limit - 1.0) < tol
