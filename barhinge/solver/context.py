@@ -39,9 +39,11 @@ class SolveContext:
         self.opts: SolverOptions = opts
         self.X0 = np.asarray(model.X0, float)
         self.n_dof = self.X0.size
+        assert scene.fixed is not None and scene.loads is not None  # set by Scene.__post_init__
         self.fixed: np.ndarray = scene.fixed.ravel()
         self.free: np.ndarray = ~self.fixed
         self.P: np.ndarray = scene.loads.ravel()
+        assert scene.prescribed is not None
         pres = scene.prescribed.ravel()
         self.u_pres = np.where(np.isfinite(pres), pres, 0.0)
         self.hinges = scene.actuator_hinges()

@@ -48,6 +48,7 @@ class FlatStart:
         follows the branch of least fold-spring energy that the rigid fold chose instead of
         the first equilibrium its own extrapolation meets."""
         ctx = self.ctx
+        assert ctx.scene.actuators is not None  # active: a flat start with actuators
         if self._guide is None and self.record is None:
             target = ctx.X0.ravel().copy()
             target[ctx.fixed] = ctx.fixed_coords(0.0)

@@ -90,7 +90,7 @@ def build_path(
     scene = ctx.scene
     rec = records
     acts = scene.actuators
-    edges = acts.edges if acts is not None else np.zeros(0, np.int64)
+    edges = np.asarray(acts.edges) if acts is not None else np.zeros(0, np.int64)
     meta: dict[str, Any] = {
         "scene": scene.name,
         "control": scene.control,
