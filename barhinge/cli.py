@@ -810,6 +810,26 @@ def main(argv: list[str] | None = None) -> None:
         sys.exit(EXIT_INTERNAL)
     if isinstance(code, int) and code != 0:
         sys.exit(code)
+    if argv is None and next((w for w in words if not w.startswith("-")), "") in _FAST_EXIT:
+        _exit_now()
+
+
+#: commands whose process ends without the interpreter's teardown once they succeeded
+_FAST_EXIT = frozenset({"fold", "view"})
+
+
+def _exit_now() -> None:
+    """End a finished CLI process at once (exit code 0): every file is written and closed,
+    and the teardown of the loaded modules (scipy, MKL, HDF5: 0.1-0.2 s) would only add to
+    the wall time of a small fold. Only for a process started as the CLI (``argv`` None),
+    never for an in-process call."""
+    import logging
+    import os
+
+    sys.stdout.flush()
+    sys.stderr.flush()
+    logging.shutdown()
+    os._exit(0)
 
 
 if __name__ == "__main__":

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import weakref
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -70,6 +71,34 @@ def _model_triangles(hinges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     tri = T[first[order]]
     wing_tri = rank[inv.ravel()].reshape(2, len(H)).T
     return tri, wing_tri
+
+
+_TOPOLOGY: weakref.WeakKeyDictionary[Any, dict[str, np.ndarray]] = weakref.WeakKeyDictionary()
+
+
+def _model_topology(model: Any) -> dict[str, np.ndarray]:
+    """What :func:`state_data` needs of a model's mesh that no state changes (triangles, the
+    bar of each fold hinge, the kind of each line), computed once per model (models are
+    frozen)."""
+    topo = _TOPOLOGY.get(model)
+    if topo is not None:
+        return topo
+    n = model.n_nodes
+    tri, wing_tri = _model_triangles(model.hinges)
+    lines = np.asarray(model.bars, np.int64)
+    fold = np.asarray(model.hinge_kind) == "fold"
+    H = np.asarray(model.hinges, np.int64)
+    key_line = _pair_index(lines, n)
+    hf = np.flatnonzero(fold)
+    order = np.argsort(key_line)
+    key_h = _pair_index(H[hf, :2], n)
+    at = np.minimum(np.searchsorted(key_line[order], key_h), len(order) - 1)
+    ok = key_line[order[at]] == key_h
+    on_edge = np.isin(key_line, _pair_index(model.pattern.edges, n))
+    topo = {"tri": tri, "wing_tri": wing_tri, "lines": lines, "fold": fold,
+            "line_of_fold": order[at[ok]], "fold_hinge": hf[ok], "on_edge": on_edge}  # fmt: skip
+    _TOPOLOGY[model] = topo
+    return topo
 
 
 def _element_energies(model: Any, X: np.ndarray, rho: np.ndarray):
@@ -136,8 +165,8 @@ def state_data(
     if model is not None:
         if model.n_nodes != n:
             raise ConfigError(f"len(X) = {n}, but the model has {model.n_nodes} nodes")
-        tri, wing_tri = _model_triangles(model.hinges)
-        lines = np.asarray(model.bars, np.int64)
+        topo = _model_topology(model)
+        tri, wing_tri, lines = topo["tri"], topo["wing_tri"], topo["lines"]
         L = np.linalg.norm(X[lines[:, 1]] - X[lines[:, 0]], axis=1)
         L0 = np.asarray(model.bar_L0, float)
         eps = (L - L0) / L0
@@ -146,19 +175,10 @@ def state_data(
         e_line = e_line / L0  # energy per length
         bar_force = bar_axial_forces(model, X)
         hinge_moment = np.asarray(model.evaluate(X, tangent=False).hinge_moment, float)
-        kind = np.asarray(model.hinge_kind)
-        fold = kind == "fold"
-        H = np.asarray(model.hinges, np.int64)
         # fold hinges: angle and energy on the bar along their axis
-        key_line = _pair_index(lines, n)
+        i, hf = topo["line_of_fold"], topo["fold_hinge"]
         fold_ang = np.full(len(lines), np.nan)
         is_crease = np.zeros(len(lines), bool)
-        hf = np.flatnonzero(fold)
-        order = np.argsort(key_line)
-        key_h = _pair_index(H[hf, :2], n)
-        at = np.minimum(np.searchsorted(key_line[order], key_h), len(order) - 1)
-        ok = key_line[order[at]] == key_h
-        i, hf = order[at[ok]], hf[ok]
         fold_ang[i] = np.degrees(rho[hf])
         moment_line = np.full(len(lines), np.nan)
         moment_line[i] = hinge_moment[hf]
@@ -167,14 +187,12 @@ def state_data(
         # bend hinges: energy split between their two triangles, per unit area
         P = X[tri]
         area = 0.5 * np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1)
-        bend = np.flatnonzero(~fold)
+        bend = np.flatnonzero(~topo["fold"])
         e_tri = np.bincount(
             wing_tri[bend].ravel(), weights=np.repeat(0.5 * e_h[bend], 2), minlength=len(tri)
         ) / np.where(area > 0, area, 1.0)
         strain_line = eps
-        cp = model.pattern
-        on_edge = np.isin(key_line, _pair_index(cp.edges, n))
-        kind_line = np.where(is_crease, 2, np.where(on_edge, 3, 1))
+        kind_line = np.where(is_crease, 2, np.where(topo["on_edge"], 3, 1))
         forces: tuple[np.ndarray, np.ndarray] | None = (bar_force, moment_line)
         Xr = model.X0 if X_ref is None else X_ref
     else:

@@ -357,10 +357,10 @@ def _frame_entry(fr: Any, n: int, m: int) -> dict[str, Any]:
     }
 
 
-def _dump(d: dict[str, Any], path: str | Path) -> Path:
+def _dump(d: dict[str, Any], path: str | Path, indent: int | None = 1) -> Path:
     path = Path(path)
     try:
-        text = json.dumps(d, indent=1, allow_nan=False)
+        text = json.dumps(d, indent=indent, allow_nan=False)
     except ValueError as exc:
         raise PatternError(f"{path.name}: cannot write FOLD ({exc})") from None
     path.write_text(text + "\n", encoding="utf-8")
@@ -435,7 +435,7 @@ def write_fold_path(cp: CreasePattern, fold_path: FoldPath, path: str | Path) ->
         frames.append(fr)
     d["file_frames"] = frames
     d["barhinge:path_kind"] = fold_path.kind
-    return _dump(d, path)
+    return _dump(d, path, indent=None)  # one line: json's C encoder, ~10x faster for many frames
 
 
 def read_fold_path(

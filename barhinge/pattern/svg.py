@@ -98,9 +98,9 @@ def _check_lengths(values: dict, where: str) -> None:
             raise PatternError(f"{where}: attribute {key}={v!r} is not a finite length")
 
 
-def _crease_kind(el: Any, where: str) -> tuple[str, float] | str | None:
-    """(assignment, fold angle in degrees) of a visible stroked SVG shape; ``"skip"`` when its
-    stroke colour is no crease kind; None when it is hidden or has no stroke. The fold angle
+def _crease_kind(el: Any, where: str) -> tuple[str | None, float] | None:
+    """(assignment, fold angle in degrees) of a visible stroked SVG shape; assignment None
+    when its stroke colour is no crease kind; None when it is hidden or has no stroke. The fold angle
     is 180 deg times the stroke's opacity (M negative, V positive, others 0)."""
     values = getattr(el, "values", {}) or {}
     if str(values.get("display", "")).strip() == "none":
@@ -113,7 +113,7 @@ def _crease_kind(el: Any, where: str) -> tuple[str, float] | str | None:
         (stroke.red, stroke.green, stroke.blue), raw if isinstance(raw, str) else None
     )
     if a is None:
-        return "skip"
+        return None, 0.0
     _check_lengths(values, where)
     op = _float(values.get("opacity"), "opacity", where)
     if values.get("stroke-opacity") is not None:  # exact value, not the 8-bit alpha
@@ -149,10 +149,10 @@ def _segments(path: Path) -> tuple[np.ndarray, list[str], list[float], dict]:
         kind = _crease_kind(el, where)
         if kind is None:
             continue
-        if kind == "skip":
+        a, rho = kind
+        if a is None:
             stats["skipped_colours"] += 1
             continue
-        a, rho = kind
         try:
             segments = list(se.Path(el).segments())
         except Exception as exc:  # malformed path data
