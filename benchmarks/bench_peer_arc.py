@@ -111,7 +111,10 @@ def main() -> None:
     lines = ["| " + " | ".join(COLS) + " |", "|" + "---|" * len(COLS)]
     print("\n".join(lines), flush=True)
     for n in a.sizes:
-        row = run(n, a.steps, a.increment)
+        try:
+            row = run(n, a.steps, a.increment)
+        except bh.ConvergenceError as exc:
+            row = (n, "failed: " + str(exc).replace("|", "/"))
         lines.append("| " + " | ".join(str(v) for v in row) + " |")
         print(lines[-1], flush=True)
     if a.publish:
