@@ -190,12 +190,15 @@ def main() -> None:
         if last is not None:
             per_it = r["assembly"] + r["fact"] + r["solve"]
             est = per_it * last["factorizations"]
+            counts = ", ".join(str(q["factorizations"]) for q in rows)
             lines += [
                 "",
                 f"Extrapolated, not measured: a full {a.steps}-step fold at n = {n} with the "
                 f"{last['factorizations']} factorisations of the n = {last['n']} fold, each "
                 f"costing one assembly + refactorisation + solve as measured here "
-                f"({per_it:.1f} s), would take about {est / 60:.0f} min.",
+                f"({per_it:.1f} s), would take about {est / 60:.0f} min. The count grows with "
+                f"the size ({counts} factorisations for n = "
+                f"{', '.join(str(q['n']) for q in rows)}), so this is a lower estimate.",
             ]
         print("\n".join(lines[-10:]), flush=True)
     if a.publish:
