@@ -5,7 +5,7 @@ factorisation of the bordered system (:class:`SolveContext`)."""
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -113,10 +113,10 @@ class SolveContext:
             self.penalty = self._auto_penalty(ev.K, terms)
         return Evaluation(ev, terms, r, c)
 
-    def _auto_penalty(self, K: object, terms: ActuatorTerms) -> float:
+    def _auto_penalty(self, K: Any, terms: ActuatorTerms) -> float:
         a = self.opts.augmentation
         self.c_scale = 1.0
-        d = np.abs(K.diagonal())  # type: ignore[attr-defined]
+        d = np.abs(K.diagonal())
         if not self.n_act:
             return 0.0
         dd = d[terms.dofs.ravel()]
