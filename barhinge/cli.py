@@ -356,6 +356,23 @@ def fold_cmd(
         bool,
         typer.Option("--viewer/--no-viewer", help="Write the interactive viewer.html."),
     ] = True,
+    accuracy: Annotated[
+        str | None,
+        typer.Option(
+            "--accuracy",
+            help="Run the lightest model (rigid form, N4B5, N5B8, subdivided panels) whose "
+            "estimated error meets this accuracy, e.g. 2%; the choice and its estimated "
+            "error go to the summary.",
+        ),
+    ] = None,
+    accuracy_for: Annotated[
+        str,
+        typer.Option(
+            "--accuracy-for",
+            help="Outputs the accuracy is for, comma-separated: stiffness, displacement, "
+            "form (default: form for a scene driven by actuators alone, else stiffness).",
+        ),
+    ] = "",
 ) -> None:
     """Fold a scene: solve it step by step, write the fold path, one summary, one step
     table and the interactive viewer (docs/outputs.md).
@@ -376,6 +393,17 @@ def fold_cmd(
     scene = default_scene() if scene_file is None else load_scene(scene_file)
     check_output_folder(out, overwrite=overwrite)  # before the solve, not after
     opts: dict[str, Any] = {"overwrite": overwrite, "pictures": level, "viewer": viewer}
+    choice = None
+    if accuracy is not None:
+        from barhinge.analysis.accuracy import scene_for_accuracy
+
+        outs = tuple(o.strip() for o in accuracy_for.split(",") if o.strip())
+        scene, choice = scene_for_accuracy(scene, accuracy, outs or None)
+        c = choice.chosen
+        err_console.print(f"model for {100 * choice.accuracy:g} % in {', '.join(choice.outputs)}: "
+                          f"{c.name} (estimated error {100 * c.error:.2g} %)",
+                          highlight=False, markup=False)  # fmt: skip
+        form_only = form_only or c.name == "rigid"
     if form_only and form_only_model(scene)[0] == "rigid":
         try:
             rigid = rigid_form(scene)
@@ -383,6 +411,8 @@ def fold_cmd(
             err_console.print(f"rigid kinematics cannot fold it ({exc}); using the bar-and-hinge "
                               "model", highlight=False, markup=False, soft_wrap=True)  # fmt: skip
         else:
+            if choice is not None:
+                rigid.meta["model_choice"] = choice.summary()
             run = write_run(rigid, scene, out, command="fold --form-only", fields=False,
                             **opts)  # fmt: skip
             _print_run(run, f"fold --form-only: {scene.name} (rigid kinematics)", as_json)
@@ -414,6 +444,8 @@ def fold_cmd(
                     err_console.print(f"partial results ({part.n_states} states) in {out}",
                                       highlight=False, markup=False)  # fmt: skip
                 raise
+        if choice is not None:
+            path.meta["model_choice"] = choice.summary()
         run = write_run(path, scene, out, **opts)
     except Interrupted as exc:
         stop = _terminated(exc)

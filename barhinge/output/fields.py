@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from barhinge.analysis.curvature import angle_defect, mixed_voronoi_area, pattern_triangles
-from barhinge.analysis.forces import bar_axial_forces
+from barhinge.analysis.forces import bar_axial_forces, panel_membrane_resultants
 from barhinge.errors import ConfigError
 from barhinge.results import FoldPath
 
@@ -101,6 +101,25 @@ def _model_topology(model: Any) -> dict[str, np.ndarray]:
     return topo
 
 
+def _triangle_membrane(model: Any, X: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """(n_tri, 9) membrane stress resultant tensor ``N`` (global axes, row-major 3 x 3,
+    force per length) of the panel each triangle lies in
+    (:func:`barhinge.analysis.forces.panel_membrane_resultants`)."""
+    from barhinge.model.triangulate import triangulate
+
+    _, Ng = panel_membrane_resultants(model, X)
+    t = triangulate(model.pattern, model.scheme)
+    n = len(X)
+    key = lambda T: np.sort(np.asarray(T, np.int64), axis=1) @ np.array([n * n, n, 1])  # noqa: E731
+    k_model, k_tri = key(t.triangles), key(tri)
+    order = np.argsort(k_model)
+    at = np.minimum(np.searchsorted(k_model[order], k_tri), len(order) - 1)
+    found = k_model[order[at]] == k_tri
+    out = np.full((len(tri), 9), np.nan)
+    out[found] = Ng[t.tri_face[order[at[found]]]].reshape(-1, 9)
+    return out
+
+
 def _element_energies(model: Any, X: np.ndarray, rho: np.ndarray):
     """(n_bars,), (n_hinges,) stored energy of every bar and hinge with the model's own laws
     (per-hinge penetration limits included); ``rho`` is unused, kept for the call sites."""
@@ -153,7 +172,9 @@ def state_data(
     laws of :mod:`barhinge.kernels.laws`), ``kind`` (0 panel, 1 bar inside a panel, 2 crease,
     3 other pattern edge: boundary or flat line); with a model also ``bar_force`` (lines: axial
     force, tension > 0, force) and ``moment`` (lines on creases: the fold hinge's moment
-    ``dW/drho``, > 0 folding it further valley than its rest angle, force x length).
+    ``dW/drho``, > 0 folding it further valley than its rest angle, force x length) and
+    ``membrane_N`` (triangles: the membrane stress resultant tensor of their panel in global
+    axes, 9 components row-major, tension > 0, force / length; NaN on lines).
     """
     X = np.asarray(X, dtype=float)
     if X.ndim != 2 or X.shape[1] != 3:
@@ -194,6 +215,7 @@ def state_data(
         strain_line = eps
         kind_line = np.where(is_crease, 2, np.where(topo["on_edge"], 3, 1))
         forces: tuple[np.ndarray, np.ndarray] | None = (bar_force, moment_line)
+        membrane = _triangle_membrane(model, X, tri)
         Xr = model.X0 if X_ref is None else X_ref
     else:
         cp = pattern
@@ -216,6 +238,7 @@ def state_data(
         e_tri = np.full(len(tri), np.nan)
         kind_line = np.where(crease, 2, 3)
         forces = None
+        membrane = None
         Xr = cp.vertices3d if X_ref is None else X_ref
     Xr = np.asarray(Xr, float)
     disp = X - Xr if Xr.shape == X.shape else np.zeros_like(X)
@@ -241,6 +264,9 @@ def state_data(
     if forces is not None:  # a model: bar forces and crease moments on the lines
         triangle_data["bar_force"] = triangle_data["moment"] = nan_t
         line_data["bar_force"], line_data["moment"] = forces
+    if membrane is not None:  # the panel's membrane stress resultant on its triangles
+        triangle_data["membrane_N"] = membrane
+        line_data["membrane_N"] = np.full((len(lines), 9), np.nan)
     return StateData(
         points=X,
         triangles=tri,

@@ -96,6 +96,8 @@ def run_summary(path: FoldPath, scene: Any = None) -> dict[str, Any]:
             path.reactions[last].sum(axis=0).tolist() if path.reactions is not None else None
         ),
         "closure_residual": path.meta.get("max_closure"),
+        # barhinge fold --accuracy: the model chosen and its estimated error
+        "model_choice": path.meta.get("model_choice"),
     }
     return out
 

@@ -100,8 +100,8 @@ def _check_lengths(values: dict, where: str) -> None:
 
 def _crease_kind(el: Any, where: str) -> tuple[str | None, float] | None:
     """(assignment, fold angle in degrees) of a visible stroked SVG shape; assignment None
-    when its stroke colour is no crease kind; None when it is hidden or has no stroke. The fold angle
-    is 180 deg times the stroke's opacity (M negative, V positive, others 0)."""
+    when its stroke colour is no crease kind; None when it is hidden or has no stroke. The
+    fold angle is 180 deg times the stroke's opacity (M negative, V positive, others 0)."""
     values = getattr(el, "values", {}) or {}
     if str(values.get("display", "")).strip() == "none":
         return None

@@ -22,7 +22,7 @@ def test_compliant_solution_approaches_rigid_path():
     rigid = bh.rigid_fold(cp, act, steps=8)
     creases = cp.crease_edges
     errors = []
-    for ratio in (1e2, 1e3, 1e4):
+    for ratio in (1e3, 1e4, 1e5):  # 1/r regime (plate-calibrated panel bending)
         model = BarHingeModel.from_pattern(
             cp,
             scheme="N5B8",

@@ -98,7 +98,9 @@ def test_stiffness_defaults_overrides_and_ratio() -> None:
     cp = bh.families.miura(2, 2)
     mat = Material(E=2e9, nu=0.3, t=1e-3)
     D = mat.bending_rigidity
-    m = BarHingeModel.from_pattern(cp, "N5B8", mat, crease_length_scale=0.05)
+    m = BarHingeModel.from_pattern(
+        cp, "N5B8", mat, crease_length_scale=0.05, bend_calibration="filipov"
+    )
     fold = m.hinge_kind == "fold"
     L = np.linalg.norm(m.X0[m.hinges[fold, 1]] - m.X0[m.hinges[fold, 0]], axis=1)
     # Filipov et al. 2017: k_F = L_F * D / L*
@@ -113,7 +115,9 @@ def test_stiffness_defaults_overrides_and_ratio() -> None:
     m3 = BarHingeModel.from_pattern(cp, "N5B8", mat, bar_EA=5.0, bend_k=2.0, fold_k=0.1)
     assert (m3.bar_EA == 5.0).all() and (m3.hinge_k[bend] == 2.0).all()
     assert (m3.hinge_k[fold] == 0.1).all()
-    m4 = BarHingeModel.from_pattern(cp, "N5B8", mat, crease_length_scale=0.05, stiffness_ratio=10.0)
+    m4 = BarHingeModel.from_pattern(
+        cp, "N5B8", mat, crease_length_scale=0.05, stiffness_ratio=10.0, bend_calibration="filipov"
+    )
     assert np.allclose(m4.bar_EA, 10 * m.bar_EA) and np.allclose(
         m4.hinge_k[bend], 10 * m.hinge_k[bend]
     )

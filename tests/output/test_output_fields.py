@@ -228,3 +228,28 @@ def test_vtu_force_fields_match_the_strains_and_fold_angles(tmp_path):
     R = m.point_data["reaction"]
     assert np.all(R[~scene.fixed.any(axis=1)] == 0.0)
     assert np.linalg.norm(R.sum(axis=0)) < 1e-8
+
+
+def test_membrane_N_field_of_a_homogeneous_stretch():
+    """A flat sheet stretched by a uniform strain e_xx: every panel triangle carries the
+    plane-stress resultant t E / (1 - nu^2) (E_xx, nu E_xx, 0) of the Green strain
+    E_xx = e + e^2 / 2 (Timoshenko & Goodier: plane stress), in global axes."""
+    import barhinge as bh
+    from barhinge.output.fields import state_mesh
+
+    cp = bh.families.miura(nx=2, ny=2, fold=0.0)
+    mat = bh.Material(E=1e6, nu=0.3, t=0.01)
+    model = bh.BarHingeModel.from_pattern(cp, "N5B8", mat)
+    e = 1e-3
+    X = np.asarray(model.X0, float).copy()
+    X[:, 0] *= 1.0 + e
+    data = state_data(X, model=model)
+    N = data.triangle_data["membrane_N"].reshape(-1, 3, 3)
+    Exx = e + e * e / 2
+    c = mat.t * mat.E / (1 - mat.nu**2)
+    np.testing.assert_allclose(N[:, 0, 0], c * Exx, rtol=1e-9)
+    np.testing.assert_allclose(N[:, 1, 1], c * mat.nu * Exx, rtol=1e-9)
+    np.testing.assert_allclose(N[:, 0, 1], 0.0, atol=1e-9 * c * Exx)
+    assert np.isnan(data.line_data["membrane_N"]).all()
+    mesh = state_mesh(data=data)
+    assert any("membrane_N" in k for k in mesh.cell_data)

@@ -20,8 +20,9 @@ def _scene(steps: int = 6) -> Scene:
     edges = miura_line_creases(cp0)
     model = BarHingeModel.from_pattern(cp0, "N5B8", fold_stiffness=0.1, bar_EA=1e3)
     acts = bh.Actuators(edges=edges, targets_deg=np.asarray(cp1.fold_angles)[edges])
-    # few long steps from flat: the first increments are cut back
-    return Scene(model, actuators=acts, steps=steps, options={"max_iter": 6})
+    # few long steps from flat: the first increments are cut back (max_iter 8: with the
+    # softer plate-calibrated panels 6 iterations no longer converge at any step size)
+    return Scene(model, actuators=acts, steps=steps, options={"max_iter": 8})
 
 
 def test_newton_stats_match_independent_counts(monkeypatch):
