@@ -276,6 +276,7 @@ class BorderedSystem:
             return K.data
         if len(blocks):
             data = K.data.copy()
+            assert self._blk_pos is not None  # set by _prepare
             np.add.at(data, self._blk_pos, blocks.ravel())
             return data
         return K.data
@@ -334,6 +335,8 @@ class BorderedSystem:
         Its pattern is built once (entries tagged with their source position in K's values
         or G's) and every later call is one gather from K's values and G's."""
         G = self.Gf
+        assert G is not None and self._data_full is not None  # an operator with actuators
+        assert self._sel is not None and self._sub_indptr is not None
         na, nnz_k, nnz_g = G.shape[0], len(self._data_full), G.nnz
         key = (self._key, upper, nnz_g, hash(G.indptr.tobytes()), hash(G.indices.tobytes()))
         if key != self._kkt_key:
@@ -359,6 +362,8 @@ class BorderedSystem:
             self._kkt_g = (np.flatnonzero(~from_k), src[~from_k] - nnz_k)  # G, then the zero
             self._kkt_pattern = (tags.indices, tags.indptr, tags.shape)
             self._kkt_key = key
+        assert self._kkt_pattern is not None and self._kkt_g is not None
+        assert self._kkt_gather is not None
         indices, indptr, shape = self._kkt_pattern
         data = self._data_full.take(self._kkt_gather)
         pos, idx = self._kkt_g
@@ -436,6 +441,7 @@ class BorderedSystem:
             return int(n_b)
         na = self.Gf.shape[0]
         if isinstance(direct, _DirectSolver):
+            assert direct.S_inv is not None  # kept with actuators
             S_inv = 0.5 * (direct.S_inv + direct.S_inv.T)  # (G A^-1 G^T)^-1
             n_b += int(np.sum(np.linalg.eigvalsh(S_inv) > 0))
         _, Y = direct.solve(np.zeros((len(self.free_idx), na)), np.eye(na))
@@ -453,8 +459,11 @@ class BorderedSystem:
         """One symmetric indefinite factorisation of the whole bordered matrix (backends
         with ``saddle_point``): no Schur complement, no ``n_act`` solves per iteration.
         Returns False (nothing kept) when the factorisation had to perturb pivots."""
+        assert self.Gf is not None  # called with actuators only
         na = self.Gf.shape[0]
-        self.factor = self.backend.factorize(self._kkt_matrix(upper=True), upper=True)
+        # saddle-point backends take the upper triangle (``upper``)
+        factorize: Any = self.backend.factorize
+        self.factor = factorize(self._kkt_matrix(upper=True), upper=True)
         self.timer.factorize += time.perf_counter() - t_start
         self.timer.n_factorizations += 1
         perturbed = getattr(self.factor, "perturbed_pivots", None)
@@ -478,22 +487,25 @@ class BorderedSystem:
         t0 = time.perf_counter()
         self.last_krylov_iters = 0
         if self.current_factored:
+            assert self.direct is not None  # current_factored: kept by _keep
             out = self.direct.solve(rhs_x, rhs_c)
             self.timer.solve += time.perf_counter() - t0
             return out
         if np.ndim(rhs_x) == 2:
             cols = [self.solve(rhs_x[:, j], rhs_c[:, j], rtol) for j in range(rhs_x.shape[1])]
             return np.stack([c[0] for c in cols], 1), np.stack([c[1] for c in cols], 1)
-        out = self._krylov(rhs_x, rhs_c, rtol)
+        kout = self._krylov(rhs_x, rhs_c, rtol)
         dt = time.perf_counter() - t0
         self.timer.solve += dt
-        if out is None:  # GMRES did not reach rtol: factorise this operator, solve directly
+        if kout is None:  # GMRES did not reach rtol: factorise this operator, solve directly
             self._factorize_current()
             t1 = time.perf_counter()
+            assert self.direct is not None  # kept by _factorize_current
             out = self.direct.solve(rhs_x, rhs_c)
             self.timer.solve += time.perf_counter() - t1
         else:
             self._krylov_cost += dt
+            out = kout
         return out
 
     def _krylov(
@@ -503,8 +515,9 @@ class BorderedSystem:
 
         Unknowns ``(dx, w = dmu / s)``, rows ``(forces, s * constraints)`` with ``s`` =
         :attr:`row_scale`, so that every entry of the residual is a force."""
-        nf = self.A.shape[0]
         A, G, p = self.A, self.Gf, self.penalty
+        assert A is not None and self.direct is not None  # an operator and a factorisation
+        nf = A.shape[0]
         s = self.row_scale
         pre = self.direct
         na = 0 if G is None else G.shape[0]
@@ -513,6 +526,7 @@ class BorderedSystem:
             dx = z[:nf]
             if not na:
                 return A @ dx
+            assert G is not None  # na > 0
             w = z[nf:]
             gdx = G @ dx
             # K_t dx = A dx - p G^T G dx (the current operator is augmented)

@@ -1,0 +1,145 @@
+"""What every control of the Newton driver evaluates: the actuator schedule and prescribed
+displacements along the path parameter, the residual and tangent at a state, and the
+factorisation of the bordered system (:class:`SolveContext`)."""
+
+from __future__ import annotations
+
+import time
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from barhinge._protocols import SolverModel
+from barhinge.linalg.backends import SingularMatrixError, get_backend
+from barhinge.solver.bordered import ActuatorTerms, BorderedSystem, Timer, actuator_terms
+from barhinge.solver.diagnose import check_finite_tangent
+from barhinge.solver.state import Evaluation, IncrementFailed, State
+from barhinge.solver_options import SolverOptions
+
+if TYPE_CHECKING:
+    from barhinge.scene import Scene
+
+__all__ = ["SolveContext"]
+
+
+class SolveContext:
+    """The discretised problem of a scene: fixed and free DOFs, loads, actuator schedule,
+    the bordered system and the scales of the convergence test.
+
+    ``force_floor`` (force) and ``penalty`` are set at the first evaluation unless the
+    options give them; ``c_scale`` (force / rad) weighs the actuator rows against the force
+    rows."""
+
+    def __init__(self, scene: Scene) -> None:
+        self.scene = scene
+        self.model: SolverModel = scene.model
+        model = self.model
+        opts = scene.options
+        assert isinstance(opts, SolverOptions)  # Scene.__post_init__ normalises it
+        self.opts: SolverOptions = opts
+        self.X0 = np.asarray(model.X0, float)
+        self.n_dof = self.X0.size
+        assert scene.fixed is not None and scene.loads is not None  # set by Scene.__post_init__
+        self.fixed: np.ndarray = scene.fixed.ravel()
+        self.free: np.ndarray = ~self.fixed
+        self.P: np.ndarray = scene.loads.ravel()
+        assert scene.prescribed is not None
+        pres = scene.prescribed.ravel()
+        self.u_pres = np.where(np.isfinite(pres), pres, 0.0)
+        self.hinges = scene.actuator_hinges()
+        self.n_act = len(self.hinges)
+        self.schedule = np.radians(scene.actuator_schedule_deg())  # (steps+1, n_act)
+        self.timer = Timer()
+        ext = np.ptp(self.X0, axis=0)
+        self.size = float(np.linalg.norm(ext)) or 1.0
+        self.force_floor: float | None = self.opts.force_floor
+        self.penalty: float | None = None
+        self.c_scale = 1.0
+
+    def make_system(self) -> BorderedSystem:
+        """The bordered system of this problem (after the scene checks)."""
+        self.backend = get_backend(self.opts.linear_solver)
+        terms0 = actuator_terms(self.model, self.X0, self.hinges)
+        self.system = BorderedSystem(
+            self.backend,
+            self.free,
+            terms0.dofs,
+            self.timer,
+            reuse=self.opts.reuses_factorization(self.scene.control),
+            krylov_max=self.opts.krylov_max,
+        )
+        return self.system
+
+    @property
+    def floor(self) -> float:
+        """The force floor of the convergence test (after the first evaluation), force."""
+        assert self.force_floor is not None
+        return self.force_floor
+
+    # ------------------------------------------------------------ schedules
+    def targets(self, t: float) -> np.ndarray:
+        """Actuator target angles (rad) at path parameter t (linear between rows)."""
+        if not self.n_act:
+            return np.zeros(0)
+        s = t * self.scene.steps
+        i = min(int(np.floor(s)), self.scene.steps - 1)
+        f = s - i
+        return (1 - f) * self.schedule[i] + f * self.schedule[i + 1]
+
+    def fixed_coords(self, t: float) -> np.ndarray:
+        """Coordinates of the fixed DOFs at path parameter t, length."""
+        return self.X0.ravel()[self.fixed] + t * self.u_pres[self.fixed]
+
+    # ------------------------------------------------------------ evaluation
+    def evaluate(self, st: State, tangent: bool = True) -> Evaluation:
+        """Residual, constraints and (unless ``tangent`` is False) the tangent at ``st``."""
+        t0 = time.perf_counter()
+        X = st.x.reshape(-1, 3)
+        tangent = tangent or self.force_floor is None or self.penalty is None
+        ev = self.model.evaluate(X, tangent=tangent)
+        self.timer.n_force_only += not tangent
+        terms = actuator_terms(self.model, X, self.hinges)
+        self.timer.assembly += time.perf_counter() - t0
+        r = np.asarray(ev.force, float).ravel() - st.lam * self.P
+        if self.n_act:
+            r = r + terms.G.T @ st.mu
+        c = terms.rho - self.targets(st.t) if self.n_act else np.zeros(0)
+        if self.n_act:
+            c = (c + np.pi) % (2 * np.pi) - np.pi
+        if self.force_floor is None:
+            d = np.abs(ev.K.diagonal())
+            self.force_floor = 1e-12 * float(d.max() if d.size else 1.0) * self.size
+        if self.penalty is None:
+            self.penalty = self._auto_penalty(ev.K, terms)
+        return Evaluation(ev, terms, r, c)
+
+    def _auto_penalty(self, K: Any, terms: ActuatorTerms) -> float:
+        a = self.opts.augmentation
+        self.c_scale = 1.0
+        d = np.abs(K.diagonal())
+        if not self.n_act:
+            return 0.0
+        dd = d[terms.dofs.ravel()]
+        kd = float(np.mean(dd)) if dd.size and np.mean(dd) > 0 else 1.0
+        g2 = float(np.mean(np.sum(terms.grad**2, axis=1)))
+        self.c_scale = kd / np.sqrt(g2) if g2 > 0 else kd
+        if a != "auto":
+            return float(a)
+        return kd / g2 if g2 > 0 else kd
+
+    def factorize(self, e: Evaluation, st: State, reuse: bool = False) -> None:
+        """Make the tangent at ``st`` the operator of the bordered system and factorise it
+        (``reuse``: unless the system keeps an earlier factorisation as GMRES
+        preconditioner)."""
+        self.system.row_scale = self.c_scale
+        check_finite_tangent(e.ev.K)  # NaN / inf never reach the factorisation
+        self.system.set_operator(e.ev.K, e.terms, st.mu, self.penalty or 0.0, factorize=not reuse)
+
+    def factorize_or_fail(
+        self, e: Evaluation, st: State, res: list[float], reuse: bool = False
+    ) -> None:
+        """:meth:`factorize`; a singular tangent fails the increment."""
+        try:
+            self.factorize(e, st, reuse)
+        except SingularMatrixError as exc:
+            raise IncrementFailed(f"singular tangent ({exc})", res) from None

@@ -1,0 +1,77 @@
+"""The states of the Newton driver: a converged or trial state (:class:`State`), everything
+evaluated at it (:class:`Evaluation`), the failure of one increment
+(:class:`IncrementFailed`), and the record of a converged state kept for the
+:class:`~barhinge.results.FoldPath` (:class:`StepRecord`, :class:`StepStats`)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from barhinge._protocols import ModelEvaluation
+from barhinge.solver.bordered import ActuatorTerms
+
+__all__ = ["Evaluation", "IncrementFailed", "State", "StepRecord", "StepStats"]
+
+
+@dataclasses.dataclass
+class State:
+    """One state of the path."""
+
+    x: np.ndarray  # (n_dof,) coordinates, flattened, length
+    mu: np.ndarray  # (n_act,) Lagrange multipliers (= -actuator moments), force x length
+    lam: float  # load factor
+    t: float  # path parameter
+
+
+@dataclasses.dataclass
+class Evaluation:
+    """Everything computed at one iterate."""
+
+    ev: ModelEvaluation
+    terms: ActuatorTerms
+    r: np.ndarray  # (n_dof,) f_int - lam P + G^T mu (all DOFs), force
+    c: np.ndarray  # (n_act,) rho - target, rad
+
+
+class IncrementFailed(Exception):
+    """One increment did not converge: ``why`` names the cause, ``residuals`` the force
+    residual norms met on the way."""
+
+    def __init__(self, why: str, residuals: list[float]) -> None:
+        super().__init__(why)
+        self.why = why
+        self.residuals = residuals
+
+
+@dataclasses.dataclass
+class StepRecord:
+    """A converged state as the FoldPath stores it."""
+
+    X: np.ndarray  # (n_nodes, 3) coordinates, length
+    fold: np.ndarray  # (n_edges,) fold angles, deg
+    targets: np.ndarray  # (n_act,) actuator targets, deg
+    moments: np.ndarray  # (n_act,) actuator moments, force x length
+    rho: np.ndarray  # (n_act,) actuator hinge angles, rad
+    eb: float  # bar energy
+    ebend: float  # panel bending energy
+    efold: float  # fold-spring energy
+    R: np.ndarray  # (n_nodes, 3) reactions, force
+    lam: float  # load factor
+    iters: int  # Newton iterations of the step
+    res: tuple[float, ...]  # force residual norms of the step
+    wall: float  # seconds since the start of the solve
+    work: float  # external work up to this state
+    neg: int | None  # negative eigenvalues of the free-DOF tangent (None: unknown)
+
+
+@dataclasses.dataclass
+class StepStats:
+    """Step control of one requested step (parameter controls)."""
+
+    iterations: int  # Newton corrections of the converged increments
+    increments: int  # converged increments
+    failed: int  # failed increments (redone shorter)
+    factorizations: int  # all factorisations
+    inertia_factorizations: int  # those made to confirm the inertia at the state
