@@ -284,7 +284,8 @@ if MAIN:
         nd = NEEDS[s]
         print(f"  needs (error <= {TARGET:g}): {label(nd) if nd else 'nothing reaches it'}")
         if s in REFERENCE_SPREAD:
-            print(f"  reference spread over {ROOF_REFERENCE_STEPS} steps: {REFERENCE_SPREAD[s]:.1e}")
+            spread = REFERENCE_SPREAD[s]
+            print(f"  reference spread over {ROOF_REFERENCE_STEPS} steps: {spread:.1e}")
     print("\n| scene | model it needs (error <= 1 %) | Pareto front: run, error, median time |")
     print("|---|---|---|")
     for s in SCENES:
