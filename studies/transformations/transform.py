@@ -37,6 +37,8 @@ PATTERNS: dict[str, tuple[str, str, dict, dict]] = {
 }
 
 CURVES = ("circle", "parabola", "spline")
+#: Newton iterations of the rigid limit's energy minimisation per step
+ENERGY_MAX_ITER = 200
 
 
 def make_pattern(name: str, quick: bool):
@@ -112,7 +114,9 @@ def rigid_limit(cp, acts, steps: int):
     import barhinge as bh
     from barhinge.kinematics.path import RigidOptions
 
-    opts = RigidOptions(check_actuators=False, over_actuated="least_squares")
+    opts = RigidOptions(
+        check_actuators=False, over_actuated="least_squares", energy_max_iter=ENERGY_MAX_ITER
+    )
     return bh.rigid_fold(cp, acts, steps=steps, fold_stiffness=rigid_weights(cp), options=opts)
 
 
