@@ -408,9 +408,15 @@ class RigidSolver:
                 mu = 1e-3 * float(K.diagonal().max(initial=1.0))
             Kf = self._Dfree @ (K + mu * eye) @ self._Dfree + self._Dact
             g = J.T @ r + sgn * viol
-            step = spla.splu(Kf.tocsc(), permc_spec="MMD_AT_PLUS_A").solve(
-                np.where(self.free, -g, 0.0)
-            )
+            try:
+                step = spla.splu(Kf.tocsc(), permc_spec="MMD_AT_PLUS_A").solve(
+                    np.where(self.free, -g, 0.0)
+                )
+            except RuntimeError:  # damping lost below round-off: damp more
+                mu *= 10.0
+                if mu > 1e12:
+                    break
+                continue
             step[~self.free] = 0.0
             r2, J2, v2 = residuals(x + step)
             f2 = float(r2 @ r2 + v2 @ v2)

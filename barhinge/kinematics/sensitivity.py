@@ -44,14 +44,14 @@ class RigidSensitivity:
         that cannot fold).
     dX_dt : (n_vertices, 3, n_act) float
         Vertex coordinates per actuator target (length per radian).
-    condition : float
-        Condition number of the reduced Hessian on the tangent space (large: the minimum is
-        nearly degenerate and the derivatives are ill-determined).
+    condition : float or None
+        With ``condition=True``: condition number of the reduced Hessian on the tangent
+        space (large: the minimum is nearly degenerate and the derivatives ill-determined).
     """
 
     drho_dt: np.ndarray
     dX_dt: np.ndarray
-    condition: float
+    condition: float | None = None
 
 
 def rigid_sensitivity(
@@ -61,6 +61,7 @@ def rigid_sensitivity(
     *,
     triangulated: bool = False,
     diagonal_stiffness: float | None = None,
+    condition: bool = False,
 ) -> RigidSensitivity:
     """Exact derivatives of the last state of ``path`` (a converged ``rigid_fold`` of ``cp``
     with the same ``fold_stiffness``) with respect to its final actuator targets.
@@ -68,7 +69,7 @@ def rigid_sensitivity(
     The fold angles come from the implicit-function theorem on the KKT system (one dense
     solve); the coordinates from differentiating the face-tree rebuild along each fold-angle
     derivative (central difference of the explicit rotation map, step 1e-6 rad, error
-    ~1e-12; no re-solve).
+    ~1e-12; no re-solve). ``condition`` also returns the reduced Hessian's condition number.
     """
     from barhinge.kinematics.path import _spring_weights
 
@@ -113,12 +114,13 @@ def rigid_sensitivity(
     drho[fi] = sol[: len(fi)]
     if not soft:
         drho[av, np.arange(na)] = 1.0
-    # conditioning of the reduced Hessian (tangent space of the free creases)
-    import scipy.linalg as sla
+    cond = None
+    if condition:  # of the reduced Hessian on the tangent space of the free creases
+        import scipy.linalg as sla
 
-    Z = sla.null_space(J[:, fi], rcond=1e-9)
-    ev = np.linalg.eigvalsh(Z.T @ H[np.ix_(fi, fi)] @ Z) if Z.shape[1] else np.ones(1)
-    cond = float(np.abs(ev).max() / max(np.abs(ev).min(), 1e-300))
+        Z = sla.null_space(J[:, fi], rcond=1e-9)
+        ev = np.linalg.eigvalsh(Z.T @ H[np.ix_(fi, fi)] @ Z) if Z.shape[1] else np.ones(1)
+        cond = float(np.abs(ev).max() / max(np.abs(ev).min(), 1e-300))
     h = 1e-6
     dX = np.stack(
         [

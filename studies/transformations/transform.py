@@ -270,7 +270,7 @@ def placement_point(
 
 def cell(kind: str, pattern: str, quick: bool = True, steps: int = 6, **params) -> dict:
     """One run of the study: ``kind`` is ``"form"`` (:func:`point`), ``"placement"``
-    (:func:`placement_point`) or ``"design"`` (``design.design``, on the quick-size sheets)."""
+    (:func:`placement_point`) or ``"design"`` (``design.design``)."""
     if kind == "form":
         return point(pattern, quick=quick, steps=steps, **params)
     if kind == "placement":
@@ -278,5 +278,5 @@ def cell(kind: str, pattern: str, quick: bool = True, steps: int = 6, **params) 
     if kind == "design":
         from design import design
 
-        return design(pattern, quick=True, **params)  # always on the small sheets
+        return design(pattern, quick=quick, **params)
     raise ValueError(f"kind must be 'form', 'placement' or 'design', got {kind!r}")
