@@ -9,6 +9,7 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
+from barhinge import _deprecated
 from barhinge import results as _results
 from barhinge._version import __version__ as __version__
 from barhinge.actuators import Actuators
@@ -22,7 +23,7 @@ _LAZY = {
     "read_fold": "barhinge.pattern.fold",
     "write_fold": "barhinge.pattern.fold",
     "read_svg": "barhinge.pattern.svg",
-    "patterns": "barhinge.patterns",
+    "families": "barhinge.families",
     "kinematics": "barhinge.kinematics",
     "analysis": "barhinge.analysis",
     "sweep": "barhinge.sweep",
@@ -33,7 +34,7 @@ _LAZY = {
     "Material": "barhinge.model.material",
     "Scene": "barhinge.scene",
     "load_scene": "barhinge.scene",
-    "solve": "barhinge.solve.newton",
+    "solve": "barhinge.solver.newton",
     "tangent_stiffness": "barhinge.analysis.stiffness",
     "gaussian_curvature": "barhinge.analysis.curvature",
     "periodic_cell": "barhinge.analysis.periodic",
@@ -61,7 +62,16 @@ def _html_display(path: FoldPath) -> str:
 _results.HTML_DISPLAY = _html_display
 
 
+_deprecated.install()
+
+#: attribute names of 0.1 that were renamed (old -> new)
+_RENAMED = {"patterns": "families"}
+
+
 def __getattr__(name: str) -> Any:
+    if name in _RENAMED:
+        _deprecated.warn_renamed(f"barhinge.{name}", f"barhinge.{_RENAMED[name]}")
+        return __getattr__(_RENAMED[name])
     if name in _LAZY:
         module = importlib.import_module(_LAZY[name])
         value = module if module.__name__ == f"barhinge.{name}" else getattr(module, name)

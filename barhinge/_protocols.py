@@ -1,5 +1,5 @@
 """The ``Protocol`` of the model the solver needs (:class:`SolverModel`) and of one
-evaluation of it (:class:`ModelEvaluation`): what :mod:`barhinge.solve` reads of a model,
+evaluation of it (:class:`ModelEvaluation`): what :mod:`barhinge.solver` reads of a model,
 written once. Kept apart from :mod:`barhinge._typing` so that ``import barhinge`` does not
 pay for it.
 """
@@ -37,7 +37,7 @@ class ModelEvaluation(Protocol):
 
 @runtime_checkable
 class SolverModel(Protocol):
-    """The model the solver needs: what :mod:`barhinge.solve` reads of a model.
+    """The model the solver needs: what :mod:`barhinge.solver` reads of a model.
     :class:`barhinge.model.model.BarHingeModel` is one; any object with these members can be
     solved.
 

@@ -122,8 +122,7 @@ class Assembler:
         total = int(seg_start[-1])
         seg = np.repeat(np.arange(n, dtype=itype), seg_len)
         del seg_len
-        p = np.arange(total, dtype=itype)
-        p -= seg_start[seg]
+        p = np.arange(total, dtype=itype) - seg_start[seg]
         k = np.repeat(indptr_n[:-1], 3)[seg]
         k += p // 3
         i = (seg % 3).astype(np.int8)

@@ -565,7 +565,7 @@ def _pattern_from(p: Any, base: Path) -> Any:
             raise ConfigError(f"pattern.file = {str(f)!r} cannot be read: {exc.strerror}") from None
     if "frame" in p:
         raise ConfigError("pattern.frame goes with pattern.file, not with pattern.family")
-    from barhinge.patterns import FAMILIES
+    from barhinge.families import FAMILIES
 
     fam = p["family"]
     if not isinstance(fam, str) or fam not in FAMILIES:
@@ -639,7 +639,7 @@ def default_scene(nx: int = 6, ny: int = 6, steps: int = 30) -> Scene:
     crease line are actuated to their rigid-folding angles at facet angle 60 deg
     (Schenk & Guest 2013); the rest of the sheet follows.
     """
-    from barhinge.patterns import miura
+    from barhinge.families import miura, miura_line_creases
 
     cp0 = miura(nx, ny, a=1.0, b=1.0, alpha=60.0, fold=5.0)
     cp1 = miura(nx, ny, a=1.0, b=1.0, alpha=60.0, fold=60.0)
@@ -656,26 +656,3 @@ def _default_model(cp: Any) -> Any:
     return BarHingeModel.from_pattern(
         cp, scheme="N5B8", material=Material(E=1e6, nu=0.3, t=0.01), fold_stiffness=1e-3
     )
-
-
-def miura_line_creases(cp: Any) -> np.ndarray:
-    """Edge ids of the M/V creases on the longest straight crease line through the vertex
-    nearest the centroid of a flat Miura sheet (edge ids are the same in folded states)."""
-    V = np.asarray(cp.vertices, float)
-    E = np.asarray(cp.edges)
-    crease = np.flatnonzero(np.isin(np.asarray(cp.assignment), ["M", "V"]))
-    c = int(np.argmin(np.linalg.norm(V - V.mean(0), axis=1)))
-    size = float(np.linalg.norm(np.ptp(V, axis=0)))
-    best = np.zeros(0, np.int64)
-    for e in crease[(E[crease] == c).any(1)]:
-        u = V[E[e, 1]] - V[E[e, 0]]
-        u /= np.linalg.norm(u)
-        # creases collinear with e: both end points on the line through c along u
-        ok = np.ones(len(crease), bool)
-        for k in (0, 1):
-            off = V[E[crease, k]] - V[c]
-            ok &= np.linalg.norm(off - np.outer(off @ u, u), axis=1) <= 1e-6 * size
-        line = crease[ok]
-        if len(line) > len(best):
-            best = line
-    return np.sort(best)

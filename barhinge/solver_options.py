@@ -110,7 +110,7 @@ class SolverOptions:
         How an actuated scene leaves a flat (singular) start, where the tangent predictor
         cannot see the folding mode: ``"rigid"`` (default) predicts the first increment by
         the energy-minimising rigid fold on the branch of the M/V assignment
-        (:mod:`barhinge.solve.branch`); ``"tangent"`` uses the plain tangent predictor (the
+        (:mod:`barhinge.solver.branch`); ``"tangent"`` uses the plain tangent predictor (the
         branch is then whatever Newton finds; use it with an imperfect start).
     """
 

@@ -247,51 +247,12 @@ class Study:
 def load_study(path: str | Path) -> Study:
     """Read a study TOML (see the module docstring); relative paths are taken from its folder."""
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ConfigError(f"study file {path} does not exist") from None
-    except IsADirectoryError:
-        raise ConfigError(f"study file {path} is a folder; expected a TOML file") from None
-    except UnicodeDecodeError:
-        raise ConfigError(f"study file {path} is not text (UTF-8 TOML expected)") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"study file {path} is not valid TOML: {exc}") from None
-    for key, kind in (("study", dict), ("grid", dict), ("fixed", dict), ("points", list)):
-        if key in data and not isinstance(data[key], kind):
-            what = "a table" if kind is dict else "an array of tables"
-            raise ConfigError(
-                f"study file {path}: {key} = {data[key]!r}; expected {what} ([{key}])"
-            )
-    unknown = set(data) - _TOP_KEYS
-    if unknown:
-        raise ConfigError(
-            f"study file {path}: unknown table(s) {sorted(unknown)}; expected {sorted(_TOP_KEYS)}"
-        )
+    data = _read_toml(path)
+    _check_tables(path, data)
     st = data.get("study", {})
-    unknown = set(st) - _STUDY_KEYS
-    if unknown:
-        raise ConfigError(
-            f"study file {path}: unknown [study] key(s) {sorted(unknown)}; "
-            f"expected {sorted(_STUDY_KEYS)}"
-        )
-    if "function" not in st:
-        raise ConfigError(f"study file {path}: [study] needs function = 'module:function'")
-    if not isinstance(st["function"], str) or st["function"].count(":") != 1:
-        raise ConfigError(
-            f"study file {path}: [study] function = {st['function']!r}; expected 'module:function'"
-        )
+    _check_study_table(path, st)
     if not all(isinstance(p, dict) for p in data.get("points", [])):
         raise ConfigError(f"study file {path}: every [[points]] entry must be a table")
-    for key in ("paths",):
-        v = st.get(key, [])
-        if not (isinstance(v, list) and all(isinstance(p, str) for p in v)):
-            raise ConfigError(
-                f"study file {path}: [study] {key} = {v!r}; expected a list of folder names"
-            )
-    for key in ("name", "out"):
-        if key in st and not isinstance(st[key], str):
-            raise ConfigError(f"study file {path}: [study] {key} = {st[key]!r}; expected text")
     base = path.resolve().parent
     out = st.get("out")
     return Study(
@@ -304,6 +265,59 @@ def load_study(path: str | Path) -> Study:
         batch_size=st.get("batch_size", 1),
         paths=tuple(str(base / p) for p in st.get("paths", [])),
     )
+
+
+def _read_toml(path: Path) -> dict[str, Any]:
+    """The TOML file ``path`` as a dict; ConfigError naming what is wrong with the file."""
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ConfigError(f"study file {path} does not exist") from None
+    except IsADirectoryError:
+        raise ConfigError(f"study file {path} is a folder; expected a TOML file") from None
+    except UnicodeDecodeError:
+        raise ConfigError(f"study file {path} is not text (UTF-8 TOML expected)") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"study file {path} is not valid TOML: {exc}") from None
+
+
+def _check_tables(path: Path, data: dict[str, Any]) -> None:
+    """The top-level tables of a study file: known names and the right kinds."""
+    for key, kind in (("study", dict), ("grid", dict), ("fixed", dict), ("points", list)):
+        if key in data and not isinstance(data[key], kind):
+            what = "a table" if kind is dict else "an array of tables"
+            raise ConfigError(
+                f"study file {path}: {key} = {data[key]!r}; expected {what} ([{key}])"
+            )
+    unknown = set(data) - _TOP_KEYS
+    if unknown:
+        raise ConfigError(
+            f"study file {path}: unknown table(s) {sorted(unknown)}; expected {sorted(_TOP_KEYS)}"
+        )
+
+
+def _check_study_table(path: Path, st: dict[str, Any]) -> None:
+    """The [study] table: known keys, ``function = 'module:function'``, text names."""
+    unknown = set(st) - _STUDY_KEYS
+    if unknown:
+        raise ConfigError(
+            f"study file {path}: unknown [study] key(s) {sorted(unknown)}; "
+            f"expected {sorted(_STUDY_KEYS)}"
+        )
+    if "function" not in st:
+        raise ConfigError(f"study file {path}: [study] needs function = 'module:function'")
+    if not isinstance(st["function"], str) or st["function"].count(":") != 1:
+        raise ConfigError(
+            f"study file {path}: [study] function = {st['function']!r}; expected 'module:function'"
+        )
+    paths = st.get("paths", [])
+    if not (isinstance(paths, list) and all(isinstance(p, str) for p in paths)):
+        raise ConfigError(
+            f"study file {path}: [study] paths = {paths!r}; expected a list of folder names"
+        )
+    for key in ("name", "out"):
+        if key in st and not isinstance(st[key], str):
+            raise ConfigError(f"study file {path}: [study] {key} = {st[key]!r}; expected text")
 
 
 # ------------------------------------------------------------------------------ worker side
@@ -705,37 +719,15 @@ def run_study(
     KeyboardInterrupt
         Passed on after the summary of what finished is written; a rerun resumes.
     """
-    if scheduler:
-        mode = "dask"
-    if mode not in ("serial", "local", "dask"):
-        raise ConfigError(f"mode must be 'serial', 'local' or 'dask', got {mode!r}")
-    if mode == "dask" and not scheduler:
-        raise ConfigError("mode 'dask' needs a scheduler address such as tcp://127.0.0.1:8786")
+    mode = _checked_mode(mode, scheduler)
     out = Path(out) if out is not None else study.out
     if out is None:
         raise ConfigError("no output folder: give out= or set [study] out")
     t0 = time.perf_counter()
     points = study.expand()
     _check_signature(study, points, required=mode == "serial")
-    pdir = _points_dir(out)
-    pdir.mkdir(parents=True, exist_ok=True)
-    for stale in [*pdir.glob(".*.tmp"), *out.glob(".*.tmp")]:  # of a killed run
-        stale.unlink(missing_ok=True)
-    spec = _dumps(dataclasses.asdict(study) | {"out": str(out)}, indent=1)
-    try:
-        same = (out / "study.json").read_text() == spec
-    except (OSError, UnicodeDecodeError):
-        same = False
-    if not same:  # the summary of another study must not sit beside this study.json
-        _remove_summary(out)
-        _atomic_write(out / "study.json", spec)
-
-    known = read_records(out)
-    mine = {p.id for p in points}
-    stray = len(set(known) - mine)
-    if stray:
-        log.info("%d records in %s belong to points outside this study; left alone", stray, out)
-    records = {k: v for k, v in known.items() if k in mine}
+    same = _prepare_folder(study, out)
+    records = _known_records(out, points)
     todo = [
         p
         for p in points
@@ -760,29 +752,8 @@ def run_study(
         stream = _serial(study, todo)
     else:
         stream = _dask(study, todo, bs, scheduler, workers, connect_timeout_s)
-    seen: set[str] = set()
-    last = time.perf_counter()
     try:
-        for recs in stream:
-            for rec in recs:
-                if rec["id"] in seen:  # cannot happen with one task per point; belt and braces
-                    log.warning("point %s finished twice; keeping the first record", rec["id"])
-                    continue
-                seen.add(rec["id"])
-                write_record(out, rec)
-                records[rec["id"]] = rec
-                rep.pending -= 1
-                if rec["status"] == "ok":
-                    rep.done += 1
-                else:
-                    rep.failed += 1
-                    log.info("point %s failed: %s", rec["id"], rec["error"])
-                rep.elapsed_s = time.perf_counter() - t0
-                if on_record:
-                    on_record(rec, rep)
-                if time.perf_counter() - last > summary_every_s:
-                    write_summary(out, points, records)
-                    last = time.perf_counter()
+        _collect(stream, out, points, rep, t0, on_record, summary_every_s)
     finally:
         close = getattr(stream, "close", None)
         if close is not None:  # shut a cluster down now, not when the generator is collected
@@ -790,3 +761,78 @@ def run_study(
         write_summary(out, points, records)
         rep.elapsed_s = time.perf_counter() - t0
     return rep
+
+
+def _checked_mode(mode: str, scheduler: str | None) -> Mode:
+    """The run mode: "dask" whenever a scheduler is given; ConfigError on a bad one."""
+    if scheduler:
+        mode = "dask"
+    if mode not in ("serial", "local", "dask"):
+        raise ConfigError(f"mode must be 'serial', 'local' or 'dask', got {mode!r}")
+    if mode == "dask" and not scheduler:
+        raise ConfigError("mode 'dask' needs a scheduler address such as tcp://127.0.0.1:8786")
+    return mode  # type: ignore[return-value]
+
+
+def _prepare_folder(study: Study, out: Path) -> bool:
+    """Create the study folder, drop temporary files of a killed run and write
+    ``study.json``; True when the folder already held this very study."""
+    pdir = _points_dir(out)
+    pdir.mkdir(parents=True, exist_ok=True)
+    for stale in [*pdir.glob(".*.tmp"), *out.glob(".*.tmp")]:  # of a killed run
+        stale.unlink(missing_ok=True)
+    spec = _dumps(dataclasses.asdict(study) | {"out": str(out)}, indent=1)
+    try:
+        same = (out / "study.json").read_text() == spec
+    except (OSError, UnicodeDecodeError):
+        same = False
+    if not same:  # the summary of another study must not sit beside this study.json
+        _remove_summary(out)
+        _atomic_write(out / "study.json", spec)
+    return same
+
+
+def _known_records(out: Path, points: Sequence[Point]) -> dict[str, Record]:
+    """The records in ``out`` of this study's points (records of other points are kept on
+    disk and left alone)."""
+    known = read_records(out)
+    mine = {p.id for p in points}
+    stray = len(set(known) - mine)
+    if stray:
+        log.info("%d records in %s belong to points outside this study; left alone", stray, out)
+    return {k: v for k, v in known.items() if k in mine}
+
+
+def _collect(
+    stream: Iterator[list[Record]],
+    out: Path,
+    points: Sequence[Point],
+    rep: SweepReport,
+    t0: float,
+    on_record: Callable[[Record, SweepReport], None] | None,
+    summary_every_s: float,
+) -> None:
+    """Write each finished record as it arrives, count it in ``rep`` and rewrite the summary
+    at most every ``summary_every_s`` seconds."""
+    seen: set[str] = set()
+    last = time.perf_counter()
+    for recs in stream:
+        for rec in recs:
+            if rec["id"] in seen:  # cannot happen with one task per point; belt and braces
+                log.warning("point %s finished twice; keeping the first record", rec["id"])
+                continue
+            seen.add(rec["id"])
+            write_record(out, rec)
+            rep.records[rec["id"]] = rec
+            rep.pending -= 1
+            if rec["status"] == "ok":
+                rep.done += 1
+            else:
+                rep.failed += 1
+                log.info("point %s failed: %s", rec["id"], rec["error"])
+            rep.elapsed_s = time.perf_counter() - t0
+            if on_record:
+                on_record(rec, rep)
+            if time.perf_counter() - last > summary_every_s:
+                write_summary(out, points, rep.records)
+                last = time.perf_counter()

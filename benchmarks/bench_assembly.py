@@ -37,7 +37,7 @@ def main() -> None:
     args = ap.parse_args()
 
     t0 = time.perf_counter()
-    cp = bh.patterns.miura(args.n, args.n, fold=args.fold)
+    cp = bh.families.miura(args.n, args.n, fold=args.fold)
     t_pattern = time.perf_counter() - t0
     t0 = time.perf_counter()
     model = BarHingeModel.from_pattern(cp, scheme=args.scheme)

@@ -9,7 +9,7 @@ Usage: python benchmarks/bench_dof.py [--sizes 10 20 35 50 70] [--repeat 3] [--n
 ``--publish`` writes the table and the fitted exponents into docs/kinematics.md between the
 ``dof-scale:start`` / ``dof-scale:end`` markers.
 
-Generated sheets (n x n unit cells of ``bh.patterns.miura``, ``yoshimura`` and ``eggbox``)
+Generated sheets (n x n unit cells of ``bh.families.miura``, ``yoshimura`` and ``eggbox``)
 and the two box-pleated FOLD files of Origami Simulator kept with the tests. Printed per
 pattern: crease variables, DOF at the flat state and at the folded state nearby (with the
 gap ratio of the rank cut), the median wall time and its split over the stages (both
@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 import barhinge as bh
+from barhinge._publish import write_between
 from barhinge.pattern.io import read
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -91,9 +92,9 @@ def row(name: str, cp, repeat: int) -> tuple[bh.DofReport, float, dict[str, floa
 
 
 FAMILY = {
-    "miura": lambda n: bh.patterns.miura(n, n),
-    "yoshimura": lambda n: bh.patterns.FAMILIES["yoshimura"](nx=n, ny=n),
-    "eggbox": lambda n: bh.patterns.FAMILIES["eggbox"](nx=n, ny=n),
+    "miura": lambda n: bh.families.miura(n, n),
+    "yoshimura": lambda n: bh.families.FAMILIES["yoshimura"](nx=n, ny=n),
+    "eggbox": lambda n: bh.families.FAMILIES["eggbox"](nx=n, ny=n),
 }
 
 
@@ -147,11 +148,8 @@ def main() -> None:
                 f"* {fam}: time ~ creases^{c[0]:.2f} ({parts}); at 10 000 creases (fit): {at:.1f} s"
             )
     if a.publish:
-        doc = DOC.read_text()
-        i, j = doc.index(START), doc.index(END)
         cmd = "python benchmarks/bench_dof.py " + " ".join(sys.argv[1:])
-        body = "\n".join([f"`{cmd}`:", "", *LINES])
-        DOC.write_text(doc[: i + len(START)] + "\n" + body + "\n" + doc[j:])
+        write_between(DOC, START, END, "\n".join([f"`{cmd}`:", "", *LINES]))
         print(f"wrote {DOC}")
 
 

@@ -15,8 +15,8 @@ import time
 
 import numpy as np
 
-from barhinge.patterns import miura
-from barhinge.patterns.miura import miura_fold_angles, miura_grid_coords, miura_layout
+from barhinge.families import miura
+from barhinge.families.miura import miura_fold_angles, miura_grid_coords, miura_layout
 
 
 def _arrays_only(n: int, fold: float | None) -> None:

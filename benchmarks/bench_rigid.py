@@ -2,7 +2,7 @@
 
 Usage: python benchmarks/bench_rigid.py [--sizes 5 10 20 35 50 70] [--steps 30] [--repeat 1]
 
-Each sheet (n x n unit cells of bh.patterns.miura, i.e. 2n x 2n quad panels) is folded from
+Each sheet (n x n unit cells of bh.families.miura, i.e. 2n x 2n quad panels) is folded from
 flat to a 120 deg zig-zag fold by one actuator crease in the middle. Printed per size: number
 of crease variables and interior vertices, set-up time (constraints + face tree), median and
 90th percentile wall time per step (steps 2..N; step 1 leaves the flat state and also checks
@@ -23,8 +23,8 @@ from barhinge.kinematics.path import RigidOptions
 
 
 def run(n: int, steps: int) -> dict:
-    cp = bh.patterns.miura(n, n)
-    lay = bh.patterns.miura_layout(n, n)
+    cp = bh.families.miura(n, n)
+    lay = bh.families.miura_layout(n, n)
     zz = lay.interior_zigzag_edges
     e = int(zz[len(zz) // 2])
     sign = 1.0 if cp.assignment[e] == "V" else -1.0

@@ -30,11 +30,12 @@ import time
 import numpy as np
 
 import barhinge as bh
+from barhinge.families import miura_line_creases
 from barhinge.linalg.backends import get_backend
 from barhinge.model.material import Material
 from barhinge.model.model import BarHingeModel
-from barhinge.scene import Scene, miura_line_creases
-from barhinge.solve.controls import BorderedSystem, Timer, actuator_terms
+from barhinge.scene import Scene
+from barhinge.solver.bordered import BorderedSystem, Timer, actuator_terms
 
 
 def _stiffness_model(cp, material: str) -> BarHingeModel:
@@ -65,9 +66,9 @@ def miura_scene(
     material: str = "quasi-rigid",
     linear_solver: str = "auto",
 ) -> Scene:
-    cp0 = bh.patterns.miura(n, n, alpha=60.0, fold=theta0)
-    cp1 = bh.patterns.miura(n, n, alpha=60.0, fold=theta1)
-    edges = miura_line_creases(bh.patterns.miura(n, n, alpha=60.0))
+    cp0 = bh.families.miura(n, n, alpha=60.0, fold=theta0)
+    cp1 = bh.families.miura(n, n, alpha=60.0, fold=theta1)
+    edges = miura_line_creases(bh.families.miura(n, n, alpha=60.0))
     model = _stiffness_model(cp0, material)
     acts = bh.Actuators(edges=edges, targets_deg=np.asarray(cp1.fold_angles)[edges])
     return Scene(
@@ -195,7 +196,7 @@ def table_fold20(repeat: int, linear_solver: str) -> None:
 
 
 def peer_scene(n: int, steps: int = 50) -> Scene:
-    cp = bh.patterns.miura(n, n, a=2.0, b=2.0, alpha=60.0, fold=15.0)
+    cp = bh.families.miura(n, n, a=2.0, b=2.0, alpha=60.0, fold=15.0)
     probe = BarHingeModel.from_pattern(cp, "N5B8", fold_stiffness=0.1, bar_EA=1e5)
     is_bend = probe.hinge_kind == "bend"
     h = probe.hinges[is_bend]

@@ -22,10 +22,10 @@ WORK = """
 import json, time, numpy as np, barhinge as bh
 from barhinge.kinematics.path import RigidOptions
 n = {n}
-cp = bh.patterns.miura(n, n)
-zz = bh.patterns.miura_layout(n, n).interior_zigzag_edges
+cp = bh.families.miura(n, n)
+zz = bh.families.miura_layout(n, n).interior_zigzag_edges
 e = int(zz[len(zz) // 2]); sign = 1.0 if cp.assignment[e] == "V" else -1.0
-bh.dof(bh.patterns.miura(2, 2))  # warm-up (imports, MKL load)
+bh.dof(bh.families.miura(2, 2))  # warm-up (imports, MKL load)
 p = bh.rigid_fold(cp, [e], [sign * 120.0], steps=12, options=RigidOptions(check_rank=False))
 step_ms = 1e3 * float(np.median(np.diff(p.wall_time)[1:]))
 t0 = time.perf_counter(); bh.dof(cp); dof_s = time.perf_counter() - t0

@@ -28,6 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
+from barhinge._publish import write_between
+
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "tests" / "data" / "crease-patterns"
 CATALOGUE = ROOT / "data" / "patterns"
@@ -41,7 +43,7 @@ def stress_patterns(folder: Path) -> list[tuple[str, list[str]]]:
     from barhinge.pattern.fold import write_fold
 
     out = [("Miura 35 × 35 (generated)", ["miura:nx=35,ny=35"])]
-    cp = bh.patterns.miura(30, 30)
+    cp = bh.families.miura(30, 30)
     drop = {cp.n_faces // 4 + 7, cp.n_faces // 2 + 31, 3 * cp.n_faces // 4 + 11}
     faces = [f for i, f in enumerate(cp.faces) if i not in drop]
     asg = cp.assignment.copy()
@@ -54,7 +56,7 @@ def stress_patterns(folder: Path) -> list[tuple[str, list[str]]]:
     out.append(
         ("Miura 30 × 30, 3 panels removed (generated)", [str(folder / "miura30_3holes.fold")])
     )
-    y = bh.patterns.FAMILIES["yoshimura"](nx=12, ny=12)
+    y = bh.families.FAMILIES["yoshimura"](nx=12, ny=12)
     asg = y.assignment.copy()
     mv = np.flatnonzero(np.isin(asg, ["M", "V"]))
     asg[mv[::2]] = "U"
@@ -171,9 +173,7 @@ def main() -> None:
     print()
     print(text)
     if a.publish:
-        doc = DOC.read_text()
-        i, j = doc.index(START), doc.index(END)
-        DOC.write_text(doc[: i + len(START)] + "\n" + text + doc[j:])
+        write_between(DOC, START, END, text)
         print(f"wrote {DOC}")
 
 

@@ -10,7 +10,7 @@ from barhinge._protocols import SolverModel
 
 
 def test_bar_hinge_model_is_a_solver_model():
-    model = bh.BarHingeModel.from_pattern(bh.patterns.miura(1, 1, fold=30.0))
+    model = bh.BarHingeModel.from_pattern(bh.families.miura(1, 1, fold=30.0))
     assert isinstance(model, SolverModel)
     ev = model.evaluate(model.X0)
     assert ev.force.shape == (model.n_dof,) and ev.K.shape == (model.n_dof, model.n_dof)

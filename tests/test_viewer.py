@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import io
 import shutil
+import time
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +17,7 @@ from barhinge.output.fields import state_data
 from barhinge.scene import default_scene
 from barhinge.view import load_view_data, viewer_html, write_viewer
 from barhinge.view.data import _node_area
+from barhinge.view.html import quantise_positions
 
 CHROMIUM = shutil.which("chromium")
 DRIVER = shutil.which("chromedriver")
@@ -76,6 +78,23 @@ def test_cli_writes_the_viewer_and_bad_paths_exit_2(run, tmp_path, capsys):
 def test_foldpath_rich_display(run):
     _, path, _ = run
     assert path._repr_html_().startswith("<iframe srcdoc=")
+
+
+def test_quantised_positions_within_half_a_step():
+    """16-bit positions: every coordinate within half a grid step of its value, the step is
+    the bounding box of the path / 65535, and the corners of the box are exact."""
+    rng = np.random.default_rng(3)
+    X = rng.normal(size=(4, 500, 3)) * [10.0, 1.0, 1e-3] + [5.0, -2.0, 0.0]
+    q, lo, step = quantise_positions(X)
+    assert q.dtype == np.uint16
+    np.testing.assert_allclose(step, (X.max(axis=(0, 1)) - X.min(axis=(0, 1))) / 65535)
+    err = np.abs(lo + q * step - X)
+    assert (err <= 0.5 * step * (1 + 1e-9)).all()
+    assert q.min() == 0 and q.max() == 65535
+    # a flat axis (a sheet in its plane) stays exact
+    X[..., 2] = 0.25
+    q, lo, step = quantise_positions(X)
+    assert step[2] == 1.0 and np.all(lo[2] + q[..., 2] * step[2] == 0.25)
 
 
 # --------------------------------------------------------------------------- the browser
@@ -188,3 +207,67 @@ def test_viewer_in_chromium(run, browser, tmp_path):
     assert f"assignment {scene.model.pattern.assignment[e]}" in tip
     assert f"fold angle {np.rint(path.fold_angles_deg[s, e] * 100) / 100:.2f}" in tip
     assert "moment" in tip and "moment \u2013" not in tip
+
+
+def test_uint16_positions_in_chromium(run, browser, tmp_path):
+    """A file with 16-bit positions: the browser's positions are the solver's within the
+    quantisation bound (half a grid step per axis, plus float32 rounding), and the file is
+    smaller than with float32 positions."""
+    _, path, out = run
+    small = write_viewer(out, tmp_path / "q.html", precision="uint16")
+    full = write_viewer(out, tmp_path / "f.html", precision="float32")
+    assert small.stat().st_size < full.stat().st_size
+    _open(browser, small)
+    assert [m for m in browser.get_log("browser") if m["level"] == "SEVERE"] == []
+    _, lo, step = quantise_positions(path.X)
+    for s in (0, path.n_states - 1):
+        js = np.array(browser.execute_script(f"return barhingeViewer.positions({s})"), float)
+        err = np.abs(js.reshape(-1, 3) - path.X[s])
+        bound = 0.5 * step + 2.0**-23 * (np.abs(path.X[s]) + np.abs(lo)) * 2
+        assert (err <= bound).all(), float((err / bound).max())
+    eps = browser.execute_script("return barhingeViewer.eps")
+    assert eps == pytest.approx(0.5 * float(np.linalg.norm(step)))
+
+
+def test_jupyter_shows_the_viewer(browser, tmp_path):
+    """A notebook run by a real kernel (nbclient): a FoldPath as the last expression of a
+    cell displays the viewer as text/html; that iframe, loaded in Chromium, runs the viewer
+    (no console error, pixels drawn)."""
+    nbformat = pytest.importorskip("nbformat")
+    nbclient = pytest.importorskip("nbclient")
+    pytest.importorskip("ipykernel")
+    code = (
+        "import numpy as np\n"
+        "import barhinge as bh\n"
+        "from barhinge.results import FoldPath\n"
+        "cps = [bh.families.miura(nx=2, ny=2, fold=t) for t in (10.0, 50.0)]\n"
+        "path = FoldPath(X=np.stack([c.vertices3d for c in cps]),\n"
+        "                fold_angles_deg=np.stack([c.fold_angles for c in cps]), kind='rigid')\n"
+        "path"
+    )
+    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(code)])
+    nbclient.NotebookClient(nb, timeout=120, kernel_name="python3").execute()
+    outputs = nb.cells[0].outputs
+    html = next(o["data"]["text/html"] for o in outputs if "text/html" in o.get("data", {}))
+    assert html.startswith("<iframe srcdoc=")
+    page = tmp_path / "notebook_output.html"
+    page.write_text(f"<!DOCTYPE html><html><body>{html}</body></html>", encoding="utf-8")
+    browser.get(page.as_uri())
+    try:
+        # the frame's document may still be loading after the page's load event (and the
+        # frame handle may then point at its first, blank document): look again until ready
+        deadline = time.monotonic() + 30
+        while True:
+            browser.switch_to.default_content()
+            browser.switch_to.frame(browser.find_element("tag name", "iframe"))
+            js = "return !!(window.barhingeViewer && barhingeViewer.ready && barhingeViewer.drawn)"
+            if browser.execute_script(js) or time.monotonic() > deadline:
+                break
+            time.sleep(0.2)
+        assert browser.execute_script(js), browser.get_log("browser")
+        assert browser.execute_script("return barhingeViewer.state") == 1
+        img = _canvas(browser, "gl")
+        assert (np.abs(img - 255).sum(axis=2) > 24).mean() > 0.01  # the sheet is drawn
+    finally:
+        browser.switch_to.default_content()
+    assert [m for m in browser.get_log("browser") if m["level"] == "SEVERE"] == []

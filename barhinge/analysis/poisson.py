@@ -188,7 +188,7 @@ def _grid(grid: Any) -> tuple[int, int]:
 
 def grid_pairs(grid: Any, period: tuple[int, int] = (2, 2)) -> tuple[np.ndarray, np.ndarray]:
     """Vertex pairs one period apart in a grid-numbered pattern (vertex ``(i, j)`` has id
-    ``j * ni + i``, as the generators of :mod:`barhinge.patterns` number them).
+    ``j * ni + i``, as the generators of :mod:`barhinge.families` number them).
 
     Parameters
     ----------

@@ -101,8 +101,8 @@ def triangulated_pattern(cp: CreasePattern) -> tuple[CreasePattern, np.ndarray]:
             continue
         f = list(f)
         if n == 4:
-            d02 = np.linalg.norm(X[f[2]] - X[f[0]])
-            d13 = np.linalg.norm(X[f[3]] - X[f[1]])
+            d02 = float(np.linalg.norm(X[f[2]] - X[f[0]]))
+            d13 = float(np.linalg.norm(X[f[3]] - X[f[1]]))
             if d13 < d02 - 1e-12 * max(d02, 1.0):
                 f = f[1:] + f[:1]
         for k in range(1, n - 1):
@@ -601,7 +601,7 @@ class NodalConstraints:
         bars = tri.edges
         X0 = cp.vertices3d
         L2 = np.sum((X0[bars[:, 1]] - X0[bars[:, 0]]) ** 2, axis=1)
-        planar = []
+        planar: list[tuple[int, int, int, int]] = []
         if not triangulated:
             for f in cp.faces:
                 planar.extend((f[0], f[1], f[2], f[k]) for k in range(3, len(f)))

@@ -637,7 +637,7 @@ def _branch_direction(rc: RigidConstraints) -> np.ndarray:
     src = rc.var_source_edge
     tgt = np.zeros(rc.n_var)
     ok = src >= 0
-    tgt[ok] = np.radians(rc.source.fold_angles[src[ok]])
+    tgt[ok] = np.radians(np.asarray(rc.source.fold_angles)[src[ok]])
     if np.any(tgt != 0.0):
         return tgt
     asg = np.where(ok, rc.source.assignment[np.maximum(src, 0)], "F")
@@ -699,7 +699,7 @@ def folded_sample(
                 break
         return rho
 
-    best = (np.inf, None)
+    best: tuple[float, np.ndarray | None] = (np.inf, None)
     collapsed = False
     for guarded in (False, True):
         for fix in (True, False):

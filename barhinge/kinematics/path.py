@@ -47,7 +47,7 @@ from barhinge.actuators import Actuators
 from barhinge.errors import ConfigError, ConvergenceError
 from barhinge.kinematics.constraints import RigidConstraints
 from barhinge.kinematics.dof import FLAT_TOL, _branch_direction
-from barhinge.linalg.backends import SingularMatrixError, get_backend
+from barhinge.linalg.backends import Factor, SingularMatrixError, get_backend
 from barhinge.linalg.nullspace import DENSE_TOL, null_space
 from barhinge.linalg.threads import single_threaded_dense
 from barhinge.pattern.crease import CreasePattern
@@ -167,7 +167,7 @@ class RigidSolver:
         self.dof_rank: tuple[int, int] | None = None
         self._Dfree = sp.diags(free.astype(float))
         self._Dact = sp.diags((~free).astype(float))
-        self._lu = None
+        self._lu: Factor | None = None
         # PARDISO pays from ~5 000 crease variables on (70 x 70 Miura, 38 920: 239 -> 95 ms
         # per step; 20 x 20, 3 120: no gain); below, SuperLU's exact LU also lands nearer
         # the exact flat state when a path crosses it (a bifurcation, where the closure
@@ -197,6 +197,7 @@ class RigidSolver:
 
     def _solve(self, rhs: np.ndarray) -> np.ndarray:
         rhs = np.where(self.free, rhs, 0.0)
+        assert self._lu is not None, "factorise before solving"
         x = self._lu.solve(rhs)
         x[~self.free] = 0.0
         return x
@@ -314,7 +315,7 @@ class RigidSolver:
         da[self.act] = dt
         b = J @ da
         d = self._solve(-(J.T @ b))
-        misfit = float(np.linalg.norm(J @ d + b) / max(np.linalg.norm(b), 1e-300))
+        misfit = float(np.linalg.norm(J @ d + b)) / max(float(np.linalg.norm(b)), 1e-300)
         return rho + d + da, misfit
 
     def leave_flat(self, rho: np.ndarray, t_new: np.ndarray) -> np.ndarray:
@@ -349,7 +350,7 @@ class RigidSolver:
         # local minima on the sign boundary, so further guesses rescale the free creases
         # (deterministic log-uniform factors in [1/8, 8]); the first that closes wins
         rng = np.random.default_rng(0)
-        best = None
+        best: tuple[tuple[bool, float], np.ndarray, list[int]] | None = None
         for attempt in range(8):
             scale = (
                 np.ones(self.rc.n_var)
@@ -364,6 +365,7 @@ class RigidSolver:
                 best = (key, x, conflicts)
             if rmax <= 1e-6 and not conflicts:
                 break
+        assert best is not None  # the loop runs at least once
         _, x, self.sign_conflicts = best
         self.branch_attempts = attempt + 1
         self._flat_setup = (rho, s * d, sgn, np.asarray(t_new, dtype=float).copy())
@@ -812,7 +814,7 @@ def rigid_fold(
                 raise failure(msg, s, hist_all) from None
             except _Incompatible as exc:
                 if not least_squares:
-                    why = _dependent_actuators(rc, rho, av, act.edges)
+                    why = _dependent_actuators(rc, rho, av, np.asarray(act.edges))
                     raise ConfigError(f"{exc}; {why}") from None
                 ok, soft_from = False, (s, str(exc).split(";")[0])
             else:
@@ -830,7 +832,7 @@ def rigid_fold(
             ev = (
                 f"step {soft_from[0]}: actuator targets incompatible ({soft_from[1]}); met in "
                 f"least squares from here, misfit up to {np.max(np.abs(mis)):.3g} deg; "
-                f"{_dependent_actuators(rc, rho_new, av, act.edges)}"
+                f"{_dependent_actuators(rc, rho_new, av, np.asarray(act.edges))}"
             )
             events.append(ev)
             log.warning(ev)
@@ -910,7 +912,7 @@ def rigid_fold(
             )
         if opt.check_actuators and not checked and np.max(np.abs(rho)) >= FLAT_TOL:
             k, r = solver.dof_rank or _actuator_rank(rc, rho, av)
-            _log_actuators(k, r, len(av), act.edges)
+            _log_actuators(k, r, len(av), np.asarray(act.edges))
             free_dof = k - r
             checked = True
         states.append(rho.copy())
@@ -1055,7 +1057,8 @@ def _dependent_actuators(
     ``rank`` are independent."""
     import scipy.linalg as sla
 
-    ns = null_space(rc.jacobian(rho))
+    ns = null_space(rc.jacobian(rho))  # no basis_limit: the basis is always formed
+    assert ns.basis is not None
     NA = ns.basis[av]
     if NA.size == 0:
         return f"the motion has no DOF left for the actuators {edges.tolist()}"
@@ -1107,7 +1110,8 @@ def _actuator_rank(rc: RigidConstraints, rho: np.ndarray, av: np.ndarray) -> tup
     """(DOF, rank of the actuators on it) at the folded state ``rho``: the nullity of the
     Jacobian and the rank of the actuator rows of its null-space basis; ``DOF - rank``
     motions are left free (resolved by the fold-spring energy)."""
-    ns = null_space(rc.jacobian(rho))
+    ns = null_space(rc.jacobian(rho))  # no basis_limit: the basis is always formed
+    assert ns.basis is not None
     NA = ns.basis[av]
     r = int(np.linalg.matrix_rank(NA, tol=1e-8)) if NA.size else 0
     return ns.basis.shape[1], r

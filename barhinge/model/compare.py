@@ -28,7 +28,7 @@ def panel_errors(
     material: Material,
     scheme: str = "N5B8",
     bar_calibration: str = "fit",
-    bend_calibration: str = "filipov",
+    bend_calibration: str = "plate",
     plate_refine: int = 4,
 ) -> dict[str, float]:
     """Relative energy errors ``U_bar / U_continuum - 1`` of a single flat panel ``P`` (k, 2):

@@ -26,6 +26,8 @@ Meshes are small (a few hundred elements) so the tests stay fast. Whole-panel co
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
@@ -35,6 +37,7 @@ from barhinge.model.material import Material
 
 __all__ = [
     "polygon_mesh",
+    "morley_plate_matrix",
     "membrane_energy",
     "membrane_edge_load",
     "plate_corner_energy",
@@ -47,15 +50,76 @@ __all__ = [
 
 
 def polygon_mesh(P: np.ndarray, refine: int = 3):
-    """skfem ``MeshTri`` of the convex polygon ``P`` (k, 2): a fan from the centroid refined
-    ``refine`` times. The corners are mesh vertices ``0..k-1``."""
+    """skfem ``MeshTri`` of the simple polygon ``P`` (k, 2): a fan from the centroid if the
+    polygon is star-shaped from it (every convex polygon), else an ear-clipping
+    triangulation of the corners; refined ``refine`` times. The corners are mesh vertices
+    ``0..k-1``. A polygon that is neither (self-intersecting, zero area) is a ConfigError."""
     from skfem import MeshTri
 
     P = np.asarray(P, dtype=float)
     k = len(P)
-    pts = np.vstack([P, P.mean(axis=0)])
-    tri = np.array([[i, (i + 1) % k, k] for i in range(k)]).T
+    c = P.mean(axis=0)
+    area = _signed_area(P)
+    if not abs(area) > 0.0:
+        raise ConfigError(f"polygon with {k} corners has zero area")
+    sign = 1.0 if area > 0 else -1.0
+    nxt = np.roll(P, -1, axis=0)
+    fan = sign * _cross(nxt - P, c - P)
+    if np.all(fan > 1e-9 * abs(area)):
+        pts = np.vstack([P, c])
+        tri = np.array([[i, (i + 1) % k, k] for i in range(k)]).T
+    else:
+        pts = P
+        tri = _ear_clip(P, sign).T
     return MeshTri(pts.T, tri).refined(refine)
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """z component of the cross product of 2-vectors (..., 2)."""
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _signed_area(P: np.ndarray) -> float:
+    """Shoelace area of the polygon ``P`` (k, 2), positive counter-clockwise."""
+    return 0.5 * float(np.sum(P[:, 0] * np.roll(P[:, 1], -1) - np.roll(P[:, 0], -1) * P[:, 1]))
+
+
+def _ear_clip(P: np.ndarray, sign: float) -> np.ndarray:
+    """(k - 2, 3) corner triangles of the simple polygon ``P`` (orientation ``sign``) by ear
+    clipping: a convex corner whose triangle holds no other corner is cut off, repeatedly."""
+    left = list(range(len(P)))
+    tris: list[list[int]] = []
+    tol = 1e-12 * abs(_signed_area(P))
+    while len(left) > 3:
+        for j in range(len(left)):
+            a, b, c = left[j - 1], left[j], left[(j + 1) % len(left)]
+            if sign * _cross(P[b] - P[a], P[c] - P[a]) <= tol:
+                continue  # reflex or flat corner
+            others = [v for v in left if v not in (a, b, c)]
+            if any(_inside(P[v], P[a], P[b], P[c], sign) for v in others):
+                continue
+            tris.append([a, b, c])
+            left.pop(j)
+            break
+        else:
+            raise ConfigError(
+                f"polygon with {len(P)} corners cannot be triangulated: it is not simple "
+                "(self-intersecting or with zero-area parts)"
+            )
+    tris.append(left)
+    T = np.array(tris, dtype=np.int64)
+    covered = 0.5 * np.abs(_cross(P[T[:, 1]] - P[T[:, 0]], P[T[:, 2]] - P[T[:, 0]])).sum()
+    if not np.isclose(covered, abs(_signed_area(P)), rtol=1e-9):
+        raise ConfigError(
+            f"polygon with {len(P)} corners cannot be triangulated: it is not simple "
+            "(self-intersecting)"
+        )
+    return T
+
+
+def _inside(x: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray, sign: float) -> bool:
+    """Whether the point ``x`` lies in the closed triangle ``a b c`` of orientation ``sign``."""
+    return all(sign * _cross(q - p, x - p) >= 0.0 for p, q in ((a, b), (b, c), (c, a)))
 
 
 def _edge_interp(P: np.ndarray, vals: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -158,15 +222,27 @@ def membrane_edge_load(
     return 2.0 * _solve_prescribed(K, np.concatenate([Dx, Dy]), np.concatenate([ux, uy]))
 
 
-def plate_corner_energy(
-    P: np.ndarray, material: Material, corner_w: np.ndarray, refine: int = 4
-) -> float:
-    """Kirchhoff-plate (Morley) energy of the polygon ``P`` (k, 2) with the deflection
-    prescribed at the k corners only (all edges free)."""
+def morley_plate_matrix(mesh: Any, material: Material) -> tuple[Any, Any]:
+    """Kirchhoff-plate stiffness on Morley's constant-moment triangle over a triangle mesh.
+
+    Parameters
+    ----------
+    mesh : skfem.MeshTri
+        For a polygon: :func:`polygon_mesh` (its first nodes are the polygon's corners).
+    material : Material
+
+    Returns
+    -------
+    K : scipy.sparse matrix
+        Stiffness of the deflection dofs, bending rigidity ``D = E t^3 / (12 (1 - nu^2))`` of
+        ``material`` (energy in the user's units).
+    basis : skfem.Basis
+        Its basis; for a :func:`polygon_mesh`, ``basis.nodal_dofs[0, :k]`` are the deflections
+        of the k corners.
+    """
     from skfem import Basis, BilinearForm, ElementTriMorley, asm
     from skfem.helpers import dd, ddot, trace
 
-    mesh = polygon_mesh(P, refine)
     basis = Basis(mesh, ElementTriMorley())
     Dp, nu = material.bending_rigidity, material.nu
 
@@ -174,9 +250,16 @@ def plate_corner_energy(
     def plate(u, v, w):
         return Dp * ((1.0 - nu) * ddot(dd(u), dd(v)) + nu * trace(dd(u)) * trace(dd(v)))
 
-    K = asm(plate, basis)
-    k = len(P)
-    D = basis.nodal_dofs[0, :k]
+    return asm(plate, basis), basis
+
+
+def plate_corner_energy(
+    P: np.ndarray, material: Material, corner_w: np.ndarray, refine: int = 4
+) -> float:
+    """Kirchhoff-plate (Morley) energy of the polygon ``P`` (k, 2) with the deflection
+    prescribed at the k corners only (all edges free)."""
+    K, basis = morley_plate_matrix(polygon_mesh(P, refine), material)
+    D = basis.nodal_dofs[0, : len(P)]
     return _solve_prescribed(K, D, np.asarray(corner_w, dtype=float))
 
 
@@ -195,18 +278,7 @@ def _condensed(K: sp.spmatrix, keep: np.ndarray, drop: np.ndarray) -> np.ndarray
 def plate_corner_stiffness(P: np.ndarray, material: Material, refine: int = 4) -> np.ndarray:
     """(k, k) Kirchhoff-plate (Morley) stiffness of the polygon ``P`` condensed to the
     deflections of its k corners (edges free)."""
-    from skfem import Basis, BilinearForm, ElementTriMorley, asm
-    from skfem.helpers import dd, ddot, trace
-
-    mesh = polygon_mesh(P, refine)
-    basis = Basis(mesh, ElementTriMorley())
-    Dp, nu = material.bending_rigidity, material.nu
-
-    @BilinearForm
-    def plate(u, v, w):
-        return Dp * ((1.0 - nu) * ddot(dd(u), dd(v)) + nu * trace(dd(u)) * trace(dd(v)))
-
-    K = asm(plate, basis)
+    K, basis = morley_plate_matrix(polygon_mesh(P, refine), material)
     keep = basis.nodal_dofs[0, : len(P)]
     drop = np.setdiff1d(np.arange(K.shape[0]), keep)
     return _condensed(K, keep, drop)

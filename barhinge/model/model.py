@@ -59,7 +59,10 @@ FOLD_LAWS = ("linear", "penetration")
 _r6, _c6 = np.triu_indices(6)
 _SYM3 = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)]
 _BAR_Q = np.array(
-    [_SYM3.index((min(a % 3, b % 3), max(a % 3, b % 3))) for a, b in zip(_r6, _c6, strict=True)]
+    [
+        _SYM3.index((min(int(a) % 3, int(b) % 3), max(int(a) % 3, int(b) % 3)))
+        for a, b in zip(_r6, _c6, strict=True)
+    ]
 )
 _BAR_SIGN = np.where((_r6 < 3) == (_c6 < 3), 1.0, -1.0)
 _BAR_FIRST = [int(np.flatnonzero((_BAR_Q == q) & (_BAR_SIGN > 0))[0]) for q in range(6)]
@@ -161,8 +164,8 @@ class BarHingeModel:
         fold_law: str = "linear",
         fold_limits_deg: tuple[float, float] = (-135.0, 135.0),
         bar_calibration: str = "fit",
-        bend_coefficient: float = BEND_COEFFICIENT_F17,
-        bend_calibration: str = "filipov",
+        bend_coefficient: float | None = None,
+        bend_calibration: str = "plate",
         bar_EA: np.ndarray | float | None = None,
         bend_k: np.ndarray | float | None = None,
         fold_k: np.ndarray | float | None = None,
@@ -186,12 +189,13 @@ class BarHingeModel:
         bar_calibration : ``"fit"`` (default, all membrane moduli), ``"filipov"`` (F17) or
             ``"dilation"`` (``"fit"`` with the uniform-dilation energy exact); the errors of
             each against a plane-stress membrane are tabulated in docs/calibration.md.
-        bend_coefficient : ``C_B`` of the Filipov bending stiffness.
-        bend_calibration : ``"filipov"`` (default, ``C_B D (D_L/t)^(1/3)``) or
-            ``"kirchhoff"`` (``2 D (1 - nu) A / D_L^2``, exact twisting of a rectangular
-            Kirchhoff plate) or ``"plate"`` (``"kirchhoff"`` scaled per face shape so that
-            the panel's corner-warping stiffness equals a Morley plate's; exact for every
-            quadrilateral; one small FE solve per distinct face shape). See
+        bend_coefficient : ``C_B`` of the ``"filipov"`` rule (default 0.55); an error with
+            the other rules.
+        bend_calibration : ``"plate"`` (default: ``"kirchhoff"`` scaled per face shape so
+            that the panel's corner-warping stiffness equals a Morley plate's; exact for every
+            quadrilateral; one small FE solve per distinct face shape), ``"kirchhoff"``
+            (``2 D (1 - nu) A / D_L^2``, exact twisting of a rectangular Kirchhoff plate) or
+            ``"filipov"`` (``C_B D (D_L/t)^(1/3)``, Filipov et al. 2017). See
             docs/calibration.md.
         bar_EA, bend_k, fold_k : overrides (scalar or per-element array: per bar, per bend
             hinge in model order, per fold hinge in model order).
@@ -216,7 +220,15 @@ class BarHingeModel:
             )
         if stiffness_ratio is not None:
             stiffness_ratio = _check.number(stiffness_ratio, "stiffness_ratio", 0.0, lo_open=True)
-        bend_coefficient = _check.number(bend_coefficient, "bend_coefficient", 0.0)
+        if bend_coefficient is None:
+            bend_coefficient = BEND_COEFFICIENT_F17
+        else:
+            bend_coefficient = _check.number(bend_coefficient, "bend_coefficient", 0.0)
+            if bend_calibration != "filipov":
+                raise ConfigError(
+                    f"bend_coefficient is the C_B of bend_calibration='filipov'; it has no "
+                    f"effect with bend_calibration={bend_calibration!r}"
+                )
         mat = Material() if material is None else material
         if not isinstance(mat, Material):
             raise ConfigError(f"material must be a Material, got {type(mat).__name__}")
@@ -293,7 +305,7 @@ class BarHingeModel:
             meta={
                 "bar_calibration": bar_calibration,
                 "bend_calibration": bend_calibration,
-                "bend_coefficient": bend_coefficient,
+                "bend_coefficient": bend_coefficient if bend_calibration == "filipov" else None,
             },
         )
 
@@ -502,7 +514,7 @@ def _override(current: np.ndarray, value: Any, n: int, name: str) -> np.ndarray:
 
 
 def plate_bend_scale(
-    cp: CreasePattern, scheme: str, material: Material, faces: np.ndarray, refine: int = 4
+    cp: CreasePattern, scheme: Scheme, material: Material, faces: np.ndarray, refine: int = 4
 ) -> np.ndarray:
     """(len(faces),) factor for the ``"kirchhoff"`` bending stiffnesses of each face so that
     the panel's corner-warping stiffness equals a Kirchhoff plate's (Morley elements,
@@ -527,14 +539,24 @@ def plate_bend_scale(
         for u, f in enumerate(first):
             Qf = Q[f]
             panel = CreasePattern(
-                Qf, [[i, (i + 1) % k] for i in range(k)], ["B"] * k, faces=[list(range(k))]
+                Qf,
+                np.array([[i, (i + 1) % k] for i in range(k)]),
+                np.array(["B"] * k),
+                faces=[list(range(k))],
             )
             m = BarHingeModel.from_pattern(
                 panel, scheme, material, bend_calibration="kirchhoff", fold_stiffness=0.0
             )
             Sb = panel_corner_stiffness(m, np.arange(k))
             Sp = plate_corner_stiffness(Qf, material, refine)
-            vals[u] = float(np.trace(Sp) / np.trace(Sb)) if np.trace(Sb) > 0 else 1.0
+            tb, tp = float(np.trace(Sb)), float(np.trace(Sp))
+            if not (np.isfinite(tb) and np.isfinite(tp) and tb > 0.0 and tp > 0.0):
+                raise ConfigError(
+                    f"bend_calibration='plate': face {int(faces[sel][f])} has no finite "
+                    "corner-warping stiffness (degenerate panel); use bend_calibration="
+                    "'kirchhoff' or 'filipov'"
+                )
+            vals[u] = tp / tb
         out[sel] = vals[inv.ravel()]
     logger.debug("plate bending calibration: %d faces", len(faces))
     return out

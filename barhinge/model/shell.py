@@ -37,7 +37,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from barhinge.errors import ConfigError
-from barhinge.model.continuum import polygon_mesh
+from barhinge.model.continuum import morley_plate_matrix, polygon_mesh
 from barhinge.model.material import Material
 
 __all__ = ["ShellModel", "shell_model"]
@@ -145,14 +145,11 @@ def _facet_local(P2: np.ndarray, material: Material, refine: int):
     """Mesh and local matrices of one facet in its plane coordinates ``P2`` (k, 2)."""
     from skfem import (
         Basis,
-        BilinearForm,
-        ElementTriMorley,
         ElementTriP1,
         ElementVector,
         LinearForm,
         asm,
     )
-    from skfem.helpers import dd, ddot, trace
     from skfem.models.elasticity import linear_elasticity
 
     mesh = polygon_mesh(P2, refine)
@@ -160,14 +157,7 @@ def _facet_local(P2: np.ndarray, material: Material, refine: int):
     bm = Basis(mesh, ElementVector(ElementTriP1()))
     mu, lam = E / (2 * (1 + nu)), E * nu / (1 - nu * nu)
     Km = t * asm(linear_elasticity(lam, mu), bm)
-    bp = Basis(mesh, ElementTriMorley())
-    Dp = material.bending_rigidity
-
-    @BilinearForm
-    def plate(u, v, w):
-        return Dp * ((1.0 - nu) * ddot(dd(u), dd(v)) + nu * trace(dd(u)) * trace(dd(v)))
-
-    Kp = asm(plate, bp)
+    Kp, bp = morley_plate_matrix(mesh, material)
 
     @LinearForm
     def one(v, w):

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import weakref
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -22,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from barhinge.analysis.curvature import angle_defect, mixed_voronoi_area, pattern_triangles
-from barhinge.analysis.forces import bar_axial_forces
+from barhinge.analysis.forces import bar_axial_forces, panel_membrane_resultants
 from barhinge.errors import ConfigError
 from barhinge.results import FoldPath
 
@@ -70,6 +71,53 @@ def _model_triangles(hinges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     tri = T[first[order]]
     wing_tri = rank[inv.ravel()].reshape(2, len(H)).T
     return tri, wing_tri
+
+
+_TOPOLOGY: weakref.WeakKeyDictionary[Any, dict[str, np.ndarray]] = weakref.WeakKeyDictionary()
+
+
+def _model_topology(model: Any) -> dict[str, np.ndarray]:
+    """What :func:`state_data` needs of a model's mesh that no state changes (triangles, the
+    bar of each fold hinge, the kind of each line), computed once per model (models are
+    frozen)."""
+    topo = _TOPOLOGY.get(model)
+    if topo is not None:
+        return topo
+    n = model.n_nodes
+    tri, wing_tri = _model_triangles(model.hinges)
+    lines = np.asarray(model.bars, np.int64)
+    fold = np.asarray(model.hinge_kind) == "fold"
+    H = np.asarray(model.hinges, np.int64)
+    key_line = _pair_index(lines, n)
+    hf = np.flatnonzero(fold)
+    order = np.argsort(key_line)
+    key_h = _pair_index(H[hf, :2], n)
+    at = np.minimum(np.searchsorted(key_line[order], key_h), len(order) - 1)
+    ok = key_line[order[at]] == key_h
+    on_edge = np.isin(key_line, _pair_index(model.pattern.edges, n))
+    topo = {"tri": tri, "wing_tri": wing_tri, "lines": lines, "fold": fold,
+            "line_of_fold": order[at[ok]], "fold_hinge": hf[ok], "on_edge": on_edge}  # fmt: skip
+    _TOPOLOGY[model] = topo
+    return topo
+
+
+def _triangle_membrane(model: Any, X: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """(n_tri, 9) membrane stress resultant tensor ``N`` (global axes, row-major 3 x 3,
+    force per length) of the panel each triangle lies in
+    (:func:`barhinge.analysis.forces.panel_membrane_resultants`)."""
+    from barhinge.model.triangulate import triangulate
+
+    _, Ng = panel_membrane_resultants(model, X)
+    t = triangulate(model.pattern, model.scheme)
+    n = len(X)
+    key = lambda T: np.sort(np.asarray(T, np.int64), axis=1) @ np.array([n * n, n, 1])  # noqa: E731
+    k_model, k_tri = key(t.triangles), key(tri)
+    order = np.argsort(k_model)
+    at = np.minimum(np.searchsorted(k_model[order], k_tri), len(order) - 1)
+    found = k_model[order[at]] == k_tri
+    out = np.full((len(tri), 9), np.nan)
+    out[found] = Ng[t.tri_face[order[at[found]]]].reshape(-1, 9)
+    return out
 
 
 def _element_energies(model: Any, X: np.ndarray, rho: np.ndarray):
@@ -124,7 +172,9 @@ def state_data(
     laws of :mod:`barhinge.kernels.laws`), ``kind`` (0 panel, 1 bar inside a panel, 2 crease,
     3 other pattern edge: boundary or flat line); with a model also ``bar_force`` (lines: axial
     force, tension > 0, force) and ``moment`` (lines on creases: the fold hinge's moment
-    ``dW/drho``, > 0 folding it further valley than its rest angle, force x length).
+    ``dW/drho``, > 0 folding it further valley than its rest angle, force x length) and
+    ``membrane_N`` (triangles: the membrane stress resultant tensor of their panel in global
+    axes, 9 components row-major, tension > 0, force / length; NaN on lines).
     """
     X = np.asarray(X, dtype=float)
     if X.ndim != 2 or X.shape[1] != 3:
@@ -136,8 +186,8 @@ def state_data(
     if model is not None:
         if model.n_nodes != n:
             raise ConfigError(f"len(X) = {n}, but the model has {model.n_nodes} nodes")
-        tri, wing_tri = _model_triangles(model.hinges)
-        lines = np.asarray(model.bars, np.int64)
+        topo = _model_topology(model)
+        tri, wing_tri, lines = topo["tri"], topo["wing_tri"], topo["lines"]
         L = np.linalg.norm(X[lines[:, 1]] - X[lines[:, 0]], axis=1)
         L0 = np.asarray(model.bar_L0, float)
         eps = (L - L0) / L0
@@ -146,19 +196,10 @@ def state_data(
         e_line = e_line / L0  # energy per length
         bar_force = bar_axial_forces(model, X)
         hinge_moment = np.asarray(model.evaluate(X, tangent=False).hinge_moment, float)
-        kind = np.asarray(model.hinge_kind)
-        fold = kind == "fold"
-        H = np.asarray(model.hinges, np.int64)
         # fold hinges: angle and energy on the bar along their axis
-        key_line = _pair_index(lines, n)
+        i, hf = topo["line_of_fold"], topo["fold_hinge"]
         fold_ang = np.full(len(lines), np.nan)
         is_crease = np.zeros(len(lines), bool)
-        hf = np.flatnonzero(fold)
-        order = np.argsort(key_line)
-        key_h = _pair_index(H[hf, :2], n)
-        at = np.minimum(np.searchsorted(key_line[order], key_h), len(order) - 1)
-        ok = key_line[order[at]] == key_h
-        i, hf = order[at[ok]], hf[ok]
         fold_ang[i] = np.degrees(rho[hf])
         moment_line = np.full(len(lines), np.nan)
         moment_line[i] = hinge_moment[hf]
@@ -167,15 +208,14 @@ def state_data(
         # bend hinges: energy split between their two triangles, per unit area
         P = X[tri]
         area = 0.5 * np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1)
-        bend = np.flatnonzero(~fold)
+        bend = np.flatnonzero(~topo["fold"])
         e_tri = np.bincount(
             wing_tri[bend].ravel(), weights=np.repeat(0.5 * e_h[bend], 2), minlength=len(tri)
         ) / np.where(area > 0, area, 1.0)
         strain_line = eps
-        cp = model.pattern
-        on_edge = np.isin(key_line, _pair_index(cp.edges, n))
-        kind_line = np.where(is_crease, 2, np.where(on_edge, 3, 1))
+        kind_line = np.where(is_crease, 2, np.where(topo["on_edge"], 3, 1))
         forces: tuple[np.ndarray, np.ndarray] | None = (bar_force, moment_line)
+        membrane = _triangle_membrane(model, X, tri)
         Xr = model.X0 if X_ref is None else X_ref
     else:
         cp = pattern
@@ -198,6 +238,7 @@ def state_data(
         e_tri = np.full(len(tri), np.nan)
         kind_line = np.where(crease, 2, 3)
         forces = None
+        membrane = None
         Xr = cp.vertices3d if X_ref is None else X_ref
     Xr = np.asarray(Xr, float)
     disp = X - Xr if Xr.shape == X.shape else np.zeros_like(X)
@@ -223,6 +264,9 @@ def state_data(
     if forces is not None:  # a model: bar forces and crease moments on the lines
         triangle_data["bar_force"] = triangle_data["moment"] = nan_t
         line_data["bar_force"], line_data["moment"] = forces
+    if membrane is not None:  # the panel's membrane stress resultant on its triangles
+        triangle_data["membrane_N"] = membrane
+        line_data["membrane_N"] = np.full((len(lines), 9), np.nan)
     return StateData(
         points=X,
         triangles=tri,

@@ -114,10 +114,10 @@ def _write(
     if npz:
         written["npz"] = fold_path.save(out / f"{name}.npz")
     if results is None:
-        from barhinge.analysis.summary import summarize
+        from barhinge.analysis.final_state import final_state_results
 
         try:
-            results = summarize(fold_path, model, pattern=cp, fixed=fixed, loads=loads)
+            results = final_state_results(fold_path, model, pattern=cp, fixed=fixed, loads=loads)
         except Exception as exc:  # noqa: BLE001 - analysis is an extra; keep the run
             log.warning("final-state analysis not written: %s", exc)
             results = {}
@@ -234,7 +234,7 @@ def write_results(
         Which states get a ``.vtu`` file.
     results : dict, optional
         The ``results`` record of ``summary.json``; default
-        :func:`barhinge.analysis.summary.summarize` of the path (with ``fixed`` and
+        :func:`barhinge.analysis.final_state.final_state_results` of the path (with ``fixed`` and
         ``loads`` for the stiffness).
     fixed, loads : (n_nodes, 3) arrays, optional
         Supports and load case of the scene (for the stiffness in the summary).

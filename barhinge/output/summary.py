@@ -2,7 +2,7 @@
 
 One summary for every kind of run: the run's status and totals (:func:`run_summary`, from
 the path alone) and, under ``results``, the final state's analysis
-(:func:`barhinge.analysis.summary.summarize`: curvature, strains, stiffness).
+(:func:`barhinge.analysis.final_state.final_state_results`: curvature, strains, stiffness).
 docs/outputs.md lists the fields and their units.
 """
 
@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from barhinge.analysis.summary import energy_split
+from barhinge.analysis.final_state import energy_split
 from barhinge.results import FoldPath
 
 __all__ = [
@@ -96,6 +96,8 @@ def run_summary(path: FoldPath, scene: Any = None) -> dict[str, Any]:
             path.reactions[last].sum(axis=0).tolist() if path.reactions is not None else None
         ),
         "closure_residual": path.meta.get("max_closure"),
+        # barhinge fold --accuracy: the model chosen and its estimated error
+        "model_choice": path.meta.get("model_choice"),
     }
     return out
 

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from barhinge.analysis.curvature import fit_quadratic, reference_points
-from barhinge.output.fields import state_data
+from barhinge.output.fields import StateData, state_data
 from barhinge.results import FoldPath
 
 __all__ = ["COLUMNS", "actuator_columns", "step_table", "write_step_table"]
@@ -48,7 +48,11 @@ def actuator_columns(edges: Any) -> list[str]:
 
 
 def step_table(
-    fold_path: FoldPath, *, model: Any | None = None, pattern: Any | None = None
+    fold_path: FoldPath,
+    *,
+    model: Any | None = None,
+    pattern: Any | None = None,
+    states: list[StateData] | None = None,
 ) -> list[dict[str, float]]:
     """One row per state with :data:`COLUMNS` and the actuator columns (NaN where a value
     does not apply).
@@ -61,6 +65,9 @@ def step_table(
     pattern : CreasePattern, optional
         Default ``model.pattern``; without a model it gives the mesh of a rigid path, and
         (with 6 faces or more) the global form whose Gaussian curvature ``K_global`` is fitted.
+    states : list of StateData, optional
+        :func:`~barhinge.output.fields.path_state_data` of the path when already computed
+        (the run writer shares it with the field files).
     """
     cp = pattern if pattern is not None else getattr(model, "pattern", None)
     act = fold_path.actuator_edges
@@ -91,11 +98,15 @@ def step_table(
     }
     if model is not None or cp is not None:
         for s in range(n):
-            d = state_data(
-                fold_path.X[s],
-                model=model,
-                pattern=cp if model is None else None,
-                fold_angles_deg=fold_path.fold_angles_deg[s] if model is None else None,
+            d = (
+                states[s]
+                if states is not None
+                else state_data(
+                    fold_path.X[s],
+                    model=model,
+                    pattern=cp if model is None else None,
+                    fold_angles_deg=fold_path.fold_angles_deg[s] if model is None else None,
+                )
             )
             cols["max_abs_bar_strain"][s] = np.nanmax(np.abs(d.line_data["bar_strain"]))
             df = d.point_data["angle_defect"]

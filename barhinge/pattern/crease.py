@@ -15,7 +15,6 @@ Conventions
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
 from functools import cached_property
 from typing import Any
 
@@ -57,7 +56,8 @@ class CreasePattern:
     fold_angles : (m,) float, optional
         Target fold angle per edge in degrees (valley > 0, mountain < 0). Defaults to 0.
     faces : sequence of int sequences, optional
-        Counter-clockwise vertex loops. Derived from the planar graph when omitted.
+        Counter-clockwise vertex loops. Derived from the planar graph when omitted; stored as
+        a tuple of int tuples.
     developable : bool
         Require sector angles to sum to 360 deg at flat interior vertices (set False for
         non-developable families such as the egg-box).
@@ -73,78 +73,23 @@ class CreasePattern:
     vertices: np.ndarray
     edges: np.ndarray
     assignment: np.ndarray
-    fold_angles: np.ndarray | None = None
-    faces: Sequence[Sequence[int]] | None = None
+    fold_angles: Any = None  # (m,) float or None in, (m,) float array stored
+    faces: Any = None  # Sequence[Sequence[int]] | None in, tuple[tuple[int, ...], ...] stored
     developable: bool = True
     meta: dict[str, Any] = dataclasses.field(default_factory=dict)
     validate: dataclasses.InitVar[bool] = True
     merge_tol: dataclasses.InitVar[float | None] = None
 
     def __post_init__(self, validate: bool, merge_tol: float | None = None) -> None:
-        V = _as_array(self.vertices, float, "vertices")
-        if V.ndim != 2 or V.shape[1] not in (2, 3):
-            raise PatternError(f"vertices must have shape (n, 2) or (n, 3), got {V.shape}")
-        if not np.all(np.isfinite(V)):
-            bad = int(np.flatnonzero(~np.all(np.isfinite(V), axis=1))[0])
-            raise PatternError(f"vertex {bad} has a non-finite coordinate: {V[bad].tolist()}")
-        E = _as_array(self.edges, None, "edges")
-        if E.size == 0:
-            E = np.zeros((0, 2), dtype=np.int64)
-        if E.ndim != 2 or E.shape[1] != 2:
-            raise PatternError(f"edges must have shape (m, 2), got {E.shape}")
-        if not np.issubdtype(E.dtype, np.integer):
-            Ef = _as_array(E, float, "edges")
-            if not np.all(Ef == np.round(Ef)):
-                raise PatternError("edges must hold integer vertex indices")
-            E = Ef.astype(np.int64)
-        E = E.astype(np.int64)
-        if E.size and (E.min() < 0 or E.max() >= len(V)):
-            bad = int(np.flatnonzero((E < 0).any(1) | (E >= len(V)).any(1))[0])
-            raise PatternError(
-                f"edge {bad} references vertex {E[bad].tolist()}, but there are {len(V)} vertices"
-            )
-        A = _as_array(
-            self.assignment if self.assignment is not None else ["U"] * len(E), None, "assignment"
-        )
-        A_list = [str(a).upper() for a in A.ravel()]
-        for i, a in enumerate(A_list):
-            if a not in ASSIGNMENTS:
-                raise PatternError(
-                    f"edge {i} has assignment {a!r}; expected one of {' '.join(ASSIGNMENTS)}"
-                )
-        A = np.array(A_list, dtype="<U1") if A_list else np.zeros(0, dtype="<U1")
-        if len(A) != len(E):
-            raise PatternError(f"len(edges) = {len(E)}, but len(assignment) = {len(A)}")
-        unknown = ~np.isin(A, ASSIGNMENTS)
-        if unknown.any():
-            bad = int(np.flatnonzero(unknown)[0])
-            raise PatternError(
-                f"edge {bad} has assignment {A[bad]!r}; expected one of {' '.join(ASSIGNMENTS)}"
-            )
-        if self.fold_angles is None:
-            F = np.zeros(len(E))
-        else:
-            F = _as_array(self.fold_angles, float, "fold_angles").ravel()
-            if len(F) != len(E):
-                raise PatternError(f"len(edges) = {len(E)}, but len(fold_angles) = {len(F)}")
-            if not np.all(np.isfinite(F)):
-                bad = int(np.flatnonzero(~np.isfinite(F))[0])
-                raise PatternError(f"edge {bad} has a non-finite fold angle {F[bad]}")
+        V = _checked_vertices(self.vertices)
+        E = _checked_edges(self.edges, len(V))
+        A = _checked_assignment(self.assignment, len(E))
+        F = _checked_fold_angles(self.fold_angles, len(E))
         faces = self.faces
         if merge_tol is not None:
             V, E, A, F, faces = merged_arrays(V, E, A, F, faces, merge_tol)
         faces_found = faces is None  # after the merge: faces of the merged graph
-        if faces_found:
-            faces = planar_faces(V, E)
-        try:
-            faces_t = tuple(tuple(int(i) for i in f) for f in faces)
-        except (TypeError, ValueError, OverflowError):
-            raise PatternError("faces must be a sequence of vertex-index sequences") from None
-        for fi, f in enumerate(faces_t):
-            if len(f) < 3:
-                raise PatternError(f"face {fi} has {len(f)} vertices; expected at least 3")
-            if min(f) < 0 or max(f) >= len(V):
-                raise PatternError(f"face {fi} references a vertex outside 0..{len(V) - 1}")
+        faces_t = _checked_faces(planar_faces(V, E) if faces_found else faces, len(V))
         object.__setattr__(self, "vertices", _readonly(V))
         object.__setattr__(self, "edges", _readonly(E))
         object.__setattr__(self, "assignment", _readonly(A))
@@ -443,3 +388,78 @@ class CreasePattern:
             f"CreasePattern(n_vertices={self.n_vertices}, n_edges={self.n_edges}, "
             f"n_faces={self.n_faces}, {asg})"
         )
+
+
+# ------------------------------------------------------------------ construction checks
+def _checked_vertices(vertices: Any) -> np.ndarray:
+    """(n, 2) or (n, 3) finite float coordinates."""
+    V = _as_array(vertices, float, "vertices")
+    if V.ndim != 2 or V.shape[1] not in (2, 3):
+        raise PatternError(f"vertices must have shape (n, 2) or (n, 3), got {V.shape}")
+    if not np.all(np.isfinite(V)):
+        bad = int(np.flatnonzero(~np.all(np.isfinite(V), axis=1))[0])
+        raise PatternError(f"vertex {bad} has a non-finite coordinate: {V[bad].tolist()}")
+    return V
+
+
+def _checked_edges(edges: Any, n_vertices: int) -> np.ndarray:
+    """(m, 2) int64 vertex pairs, every index in ``0..n_vertices - 1``."""
+    E = _as_array(edges, None, "edges")
+    if E.size == 0:
+        E = np.zeros((0, 2), dtype=np.int64)
+    if E.ndim != 2 or E.shape[1] != 2:
+        raise PatternError(f"edges must have shape (m, 2), got {E.shape}")
+    if not np.issubdtype(E.dtype, np.integer):
+        Ef = _as_array(E, float, "edges")
+        if not np.all(Ef == np.round(Ef)):
+            raise PatternError("edges must hold integer vertex indices")
+        E = Ef.astype(np.int64)
+    E = E.astype(np.int64)
+    if E.size and (E.min() < 0 or E.max() >= n_vertices):
+        bad = int(np.flatnonzero((E < 0).any(1) | (E >= n_vertices).any(1))[0])
+        raise PatternError(
+            f"edge {bad} references vertex {E[bad].tolist()}, but there are {n_vertices} vertices"
+        )
+    return E
+
+
+def _checked_assignment(assignment: Any, n_edges: int) -> np.ndarray:
+    """(m,) one-letter assignments from ``ASSIGNMENTS`` (upper case; ``U`` when None)."""
+    A = _as_array(assignment if assignment is not None else ["U"] * n_edges, None, "assignment")
+    letters = [str(a).upper() for a in A.ravel()]
+    for i, a in enumerate(letters):
+        if a not in ASSIGNMENTS:
+            raise PatternError(
+                f"edge {i} has assignment {a!r}; expected one of {' '.join(ASSIGNMENTS)}"
+            )
+    A = np.array(letters, dtype="<U1") if letters else np.zeros(0, dtype="<U1")
+    if len(A) != n_edges:
+        raise PatternError(f"len(edges) = {n_edges}, but len(assignment) = {len(A)}")
+    return A
+
+
+def _checked_fold_angles(fold_angles: Any, n_edges: int) -> np.ndarray:
+    """(m,) finite fold angles in degrees (zeros when None)."""
+    if fold_angles is None:
+        return np.zeros(n_edges)
+    F = _as_array(fold_angles, float, "fold_angles").ravel()
+    if len(F) != n_edges:
+        raise PatternError(f"len(edges) = {n_edges}, but len(fold_angles) = {len(F)}")
+    if not np.all(np.isfinite(F)):
+        bad = int(np.flatnonzero(~np.isfinite(F))[0])
+        raise PatternError(f"edge {bad} has a non-finite fold angle {F[bad]}")
+    return F
+
+
+def _checked_faces(faces: Any, n_vertices: int) -> tuple[tuple[int, ...], ...]:
+    """Faces as a tuple of int tuples, each with >= 3 vertices in ``0..n_vertices - 1``."""
+    try:
+        faces_t = tuple(tuple(int(i) for i in f) for f in faces)
+    except (TypeError, ValueError, OverflowError):
+        raise PatternError("faces must be a sequence of vertex-index sequences") from None
+    for fi, f in enumerate(faces_t):
+        if len(f) < 3:
+            raise PatternError(f"face {fi} has {len(f)} vertices; expected at least 3")
+        if min(f) < 0 or max(f) >= n_vertices:
+            raise PatternError(f"face {fi} references a vertex outside 0..{n_vertices - 1}")
+    return faces_t

@@ -24,6 +24,7 @@ from __future__ import annotations
 import logging
 import re
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -97,6 +98,32 @@ def _check_lengths(values: dict, where: str) -> None:
             raise PatternError(f"{where}: attribute {key}={v!r} is not a finite length")
 
 
+def _crease_kind(el: Any, where: str) -> tuple[str | None, float] | None:
+    """(assignment, fold angle in degrees) of a visible stroked SVG shape; assignment None
+    when its stroke colour is no crease kind; None when it is hidden or has no stroke. The
+    fold angle is 180 deg times the stroke's opacity (M negative, V positive, others 0)."""
+    values = getattr(el, "values", {}) or {}
+    if str(values.get("display", "")).strip() == "none":
+        return None
+    stroke = el.stroke
+    if stroke is None or stroke.value is None:
+        return None
+    raw = values.get("stroke")
+    a = assignment_of_colour(
+        (stroke.red, stroke.green, stroke.blue), raw if isinstance(raw, str) else None
+    )
+    if a is None:
+        return None, 0.0
+    _check_lengths(values, where)
+    op = _float(values.get("opacity"), "opacity", where)
+    if values.get("stroke-opacity") is not None:  # exact value, not the 8-bit alpha
+        sop = _float(values.get("stroke-opacity"), "stroke-opacity", where)
+    else:  # rgba() / #rrggbbaa colours carry it in the alpha channel
+        sop = stroke.opacity if stroke.opacity is not None else 1.0
+    frac = op * float(sop)
+    return a, {"M": -180.0 * frac, "V": 180.0 * frac}.get(a, 0.0)
+
+
 def _segments(path: Path) -> tuple[np.ndarray, list[str], list[float], dict]:
     """Straight segments (k, 4) [x0, y0, x1, y1] in SVG coordinates, their assignments and
     fold angles (degrees)."""
@@ -119,27 +146,13 @@ def _segments(path: Path) -> tuple[np.ndarray, list[str], list[float], dict]:
     for el in elements:
         if not isinstance(el, se.Shape):
             continue
-        values = getattr(el, "values", {}) or {}
-        if str(values.get("display", "")).strip() == "none":
+        kind = _crease_kind(el, where)
+        if kind is None:
             continue
-        stroke = el.stroke
-        if stroke is None or stroke.value is None:
-            continue
-        raw = values.get("stroke")
-        a = assignment_of_colour(
-            (stroke.red, stroke.green, stroke.blue), raw if isinstance(raw, str) else None
-        )
+        a, rho = kind
         if a is None:
             stats["skipped_colours"] += 1
             continue
-        _check_lengths(values, where)
-        op = _float(values.get("opacity"), "opacity", where)
-        if values.get("stroke-opacity") is not None:  # exact value, not the 8-bit alpha
-            sop = _float(values.get("stroke-opacity"), "stroke-opacity", where)
-        else:  # rgba() / #rrggbbaa colours carry it in the alpha channel
-            sop = stroke.opacity if stroke.opacity is not None else 1.0
-        frac = op * float(sop)
-        rho = {"M": -180.0 * frac, "V": 180.0 * frac}.get(a, 0.0)
         try:
             segments = list(se.Path(el).segments())
         except Exception as exc:  # malformed path data

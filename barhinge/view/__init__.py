@@ -19,12 +19,14 @@ from barhinge.view.html import write_html
 __all__ = ["ViewData", "iframe_html", "load_view_data", "view_data", "viewer_html", "write_viewer"]
 
 
-def viewer_html(source: Any, **kwargs: Any) -> str:
+def viewer_html(source: Any, precision: str = "auto", **kwargs: Any) -> str:
     """The viewer of ``source`` (see :func:`write_viewer`) as one HTML string."""
-    return _viewer_html(load_view_data(source, **kwargs))
+    return _viewer_html(load_view_data(source, **kwargs), precision)
 
 
-def write_viewer(source: Any, html_path: str | Path, **kwargs: Any) -> Path:
+def write_viewer(
+    source: Any, html_path: str | Path, precision: str = "auto", **kwargs: Any
+) -> Path:
     """Write the viewer of a fold path to one self-contained HTML file.
 
     Parameters
@@ -35,6 +37,11 @@ def write_viewer(source: Any, html_path: str | Path, **kwargs: Any) -> Path:
         with ``model=``, ``scene=`` or ``pattern=``.
     html_path : path
         The file to write (its folder must exist).
+    precision : {"auto", "float32", "uint16"}
+        Positions as float32, or as 16-bit integers on a grid over the path's bounding box
+        (each coordinate within ``extent / 131070`` of its value; the file's positions are
+        half the size). ``"auto"``: 16-bit above
+        :data:`~barhinge.view.html.QUANTISE_ABOVE` node-states.
     **kwargs
         ``model``, ``scene``, ``pattern``, ``fixed``, ``loads``, ``title`` for a FoldPath.
 
@@ -47,7 +54,7 @@ def write_viewer(source: Any, html_path: str | Path, **kwargs: Any) -> Path:
     ConfigError
         The source is missing or not a fold path, or the path and its pattern disagree.
     """
-    return write_html(load_view_data(source, **kwargs), html_path)
+    return write_html(load_view_data(source, **kwargs), html_path, precision)
 
 
 def iframe_html(source: Any, height: int = 760, **kwargs: Any) -> str:

@@ -1,5 +1,7 @@
 // barhinge fold-path viewer: WebGL2 sheet, 2-D crease pattern, charts. No network, no library.
-// Data: window.BH (JSON written by barhinge.view); arrays are base64 little-endian typed arrays.
+// Data: the JSON of #bh-data (the mesh, the run) and one base64 block per state and array
+// (#bh-X<s> positions, #bh-F<s> fold angles, #bh-M<s> moments, #bh-E<s> energies), decoded
+// when a state is first shown. Arrays are little-endian typed arrays.
 "use strict";
 window.addEventListener("error", (e) => {  // say it on the page too, not only in the console
   const m = document.getElementById("msg");
@@ -15,15 +17,32 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
     for (let i = 0; i < b.length; i++) u[i] = b.charCodeAt(i);
     return new T(u.buffer);
   }
-  const S = D.n_states, N = D.n_nodes;
-  const X = dec(D.X, Float32Array);               // S*N*3
+  const S = D.n_states, N = D.n_nodes, QP = D.positions;
+  // positions: float32, or uint16 on a grid (lo + q * step) whose half step bounds the error
+  const EPS = QP.dtype === "uint16" ? 0.5 * Math.hypot(...QP.step) : 0;
+  const blocks = new Map();
+  function block(k, s, decode) {
+    const key = `${k}${s}`;
+    if (!blocks.has(key)) blocks.set(key, decode(document.getElementById(`bh-${key}`).textContent));
+    return blocks.get(key);
+  }
+  function pos(s) {  // (N*3) float32 positions of state s
+    return block("X", s, (t) => {
+      if (QP.dtype !== "uint16") return dec(t, Float32Array);
+      const q = dec(t, Uint16Array), P = new Float32Array(3 * N), lo = QP.lo, st = QP.step;
+      for (let i = 0; i < 3 * N; i += 3) {
+        P[i] = lo[0] + q[i] * st[0]; P[i + 1] = lo[1] + q[i + 1] * st[1]; P[i + 2] = lo[2] + q[i + 2] * st[2];
+      }
+      return P;
+    });
+  }
+  const foldOf = (s) => block("F", s, (t) => Float32Array.from(dec(t, Int16Array), (q) => q / 100));  // deg
+  const HAS_M = D.blocks.includes("M"), HAS_E = D.blocks.includes("E");
+  const momOf = (s) => block("M", s, (t) => dec(t, Float32Array));
   const TRI = dec(D.triangles, Uint32Array);      // T*3
   const BARS = dec(D.bars, Uint32Array);          // B*2
   const L0 = dec(D.bar_L0, Float32Array);
   const CR = dec(D.creases, Uint32Array);         // E*2
-  const FOLD = Float32Array.from(dec(D.fold_cdeg, Int16Array), (q) => q / 100);  // S*E, deg
-  const MOM = D.moment ? dec(D.moment, Float32Array) : null;
-  const EN = D.energy_density ? dec(D.energy_density, Float32Array) : null;
   const FLAT = dec(D.flat, Float32Array);         // Nv*2
   const FIXED = D.fixed ? dec(D.fixed, Uint8Array) : null;  // N*3
   const LOADS = D.loads ? dec(D.loads, Float32Array) : null;
@@ -45,14 +64,14 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
   })();
   const used = new Uint8Array(N);
   for (let i = 0; i < TRI.length; i++) used[TRI[i]] = 1;
-  function pos(s) { return X.subarray(3 * N * s, 3 * N * (s + 1)); }
 
   function barStrainNodes(s) {  // mean engineering strain (L - L0)/L0 of the bars at each node
     const P = pos(s), sum = new Float64Array(N), cnt = new Float64Array(N);
     for (let b = 0; b < B; b++) {
       const i = BARS[2 * b], j = BARS[2 * b + 1];
       const dx = P[3 * j] - P[3 * i], dy = P[3 * j + 1] - P[3 * i + 1], dz = P[3 * j + 2] - P[3 * i + 2];
-      const e = (Math.hypot(dx, dy, dz) - L0[b]) / L0[b];
+      const dL = Math.hypot(dx, dy, dz) - L0[b];
+      const e = Math.abs(dL) <= 2 * EPS ? 0 : dL / L0[b];  // below the stored positions' resolution: 0
       sum[i] += e; sum[j] += e; cnt[i]++; cnt[j]++;
     }
     const out = new Float64Array(N);
@@ -66,7 +85,9 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
     return out;
   }
   function gaussian(s) {  // angle defect / mixed Voronoi area (Meyer et al. 2003), NaN at the boundary
-    const P = pos(s), ang = new Float64Array(N), area = new Float64Array(N);
+    // with 16-bit positions a corner angle is known to 2 EPS (1/|a| + 1/|b|) (first order in
+    // the position error EPS of each end): a node's defect within the sum of these is 0
+    const P = pos(s), ang = new Float64Array(N), area = new Float64Array(N), err = new Float64Array(N);
     const v = (a, b) => [P[3 * b] - P[3 * a], P[3 * b + 1] - P[3 * a + 1], P[3 * b + 2] - P[3 * a + 2]];
     const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     const cr = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
@@ -76,6 +97,7 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
         const p = id[c], q = id[(c + 1) % 3], r = id[(c + 2) % 3];
         const a = v(p, q), b = v(p, r), o = v(q, r);
         A.push(Math.atan2(Math.hypot(...cr(a, b)), dot(a, b)));
+        if (EPS) err[p] += 2 * EPS * (1 / Math.sqrt(dot(a, a)) + 1 / Math.sqrt(dot(b, b)));
         L2.push(dot(o, o));  // squared length of the side opposite corner c
       }
       const e1 = v(id[0], id[1]), e2 = v(id[0], id[2]);
@@ -94,21 +116,24 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
       }
     }
     const out = new Float64Array(N);
-    for (let i = 0; i < N; i++) out[i] = boundary[i] || !used[i] ? NaN : (2 * Math.PI - ang[i]) / area[i];
+    for (let i = 0; i < N; i++) {
+      const d = 2 * Math.PI - ang[i];
+      out[i] = boundary[i] || !used[i] ? NaN : Math.abs(d) <= err[i] ? 0 : d / area[i];
+    }
     return out;
   }
   function foldNodes(s) {  // mean fold angle of the creases at each node (deg)
-    const sum = new Float64Array(N), cnt = new Float64Array(N), out = new Float64Array(N);
+    const F = foldOf(s), sum = new Float64Array(N), cnt = new Float64Array(N), out = new Float64Array(N);
     for (let e = 0; e < E; e++) {
       const a = ASSIGN[e];
       if (a !== "M" && a !== "V" && a !== "U") continue;
-      const f = FOLD[s * E + e];
+      const f = F[e];
       for (const i of [CR[2 * e], CR[2 * e + 1]]) { sum[i] += f; cnt[i]++; }
     }
     for (let i = 0; i < N; i++) out[i] = cnt[i] ? sum[i] / cnt[i] : NaN;
     return out;
   }
-  function energy(s) { return Float64Array.from(EN.subarray(N * s, N * (s + 1))); }
+  function energy(s) { return Float64Array.from(block("E", s, (t) => dec(t, Float32Array))); }
 
   const MODES = {
     fold: { label: "fold angle (deg): mountain red, valley blue", f: foldNodes, div: true, mv: true },
@@ -117,7 +142,7 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
     gaussian: { label: "Gaussian curvature (angle defect / area, 1/length\u00b2)", f: gaussian, div: true },
   };
   if (!E) delete MODES.fold;
-  if (EN) MODES.energy = { label: "energy density (energy / area)", f: energy, div: false };
+  if (HAS_E) MODES.energy = { label: "energy density (energy / area)", f: energy, div: false };
 
   // colour range of a mode: over all states (fixed while playing), symmetric for diverging maps
   const ranges = {};
@@ -128,7 +153,7 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
     for (let s = 0; s < S; s += step) states.push(s);
     if (states[states.length - 1] !== S - 1) states.push(S - 1);
     const scan = (v) => { for (const x of v) if (Number.isFinite(x)) { if (x < lo) lo = x; if (x > hi) hi = x; } };
-    if (m === "fold") scan(FOLD); else for (const s of states) scan(MODES[m].f(s));
+    if (m === "fold") { lo = -D.fold_absmax; hi = D.fold_absmax; } else for (const s of states) scan(MODES[m].f(s));
     if (!Number.isFinite(lo)) { lo = 0; hi = 1; }
     if (MODES[m].div) { const a = Math.max(Math.abs(lo), Math.abs(hi)) || 1; lo = -a; hi = a; }
     if (hi <= lo) hi = lo + 1;
@@ -190,8 +215,7 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
   for (const i of loadN) maxLoad = Math.max(maxLoad, Math.hypot(LOADS[3 * i], LOADS[3 * i + 1], LOADS[3 * i + 2]));
 
   // bounding box over all states: a fixed camera target and scale
-  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
-  for (let i = 0; i < X.length; i += 3) for (let k = 0; k < 3; k++) { lo[k] = Math.min(lo[k], X[i + k]); hi[k] = Math.max(hi[k], X[i + k]); }
+  const [lo, hi] = D.box;
   const center = [0, 1, 2].map((k) => (lo[k] + hi[k]) / 2);
   const radius = 0.5 * Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 1;
   const cam = { yaw: -0.6, pitch: 0.75, dist: 2.0 * radius, target: center.slice() };
@@ -217,30 +241,51 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
 
   // ---------------------------------------------------------------- state
   const V = { state: 0, mode: "fold", hover: -1, ready: false, values: null };
+  const luts = {};
+  function lut(m) {  // 256 colours of a mode's map
+    if (!luts[m]) { luts[m] = new Float32Array(768); for (let j = 0; j < 256; j++) luts[m].set(cmap(m, j / 255), 3 * j); }
+    return luts[m];
+  }
+  const cbuf = new Float32Array(3 * N);
   function colours(s) {
-    const vals = MODES[V.mode].f(s), [a, b] = range(V.mode), c = new Float32Array(3 * N);
-    V.values = vals;
+    const c = cbuf;
+    if (V.mode === "fold") {  // fold angles live on the creases (coloured lines): panels stay paper-coloured
+      for (let i = 0; i < 3 * N; i += 3) { c[i] = 0.93; c[i + 1] = 0.92; c[i + 2] = 0.88; }
+      return c;
+    }
+    const vals = MODES[V.mode].f(s), [a, b] = range(V.mode), L = lut(V.mode);
     for (let i = 0; i < N; i++) {
       const x = vals[i];
-      // fold angles live on the creases (coloured lines): panels stay paper-coloured
-      const k = V.mode === "fold" ? [0.93, 0.92, 0.88] : Number.isFinite(x) ? cmap(V.mode, (x - a) / (b - a)) : [0.75, 0.75, 0.75];
-      c[3 * i] = k[0]; c[3 * i + 1] = k[1]; c[3 * i + 2] = k[2];
+      if (!Number.isFinite(x)) { c[3 * i] = c[3 * i + 1] = c[3 * i + 2] = 0.75; continue; }
+      const j = 3 * Math.round(255 * Math.min(Math.max((x - a) / (b - a), 0), 1));
+      c[3 * i] = L[j]; c[3 * i + 1] = L[j + 1]; c[3 * i + 2] = L[j + 2];
     }
     return c;
   }
+  const LINE_COL = new Float32Array(3 * E);  // each crease's colour outside the fold mode
+  for (let e = 0; e < E; e++) LINE_COL.set(ACT.has(e) ? [0.1, 0.7, 0.2] : MV[ASSIGN[e]] || MV.U, 3 * e);
+  const BY_ANGLE = Uint8Array.from({ length: E }, (_, e) => (ASSIGN[e] !== "B" && !ACT.has(e) ? 1 : 0));
+  let lbuf = null;
   function lineData(P, s) {
     const n = 2 * lineIdx.length + 2 * loadN.length + supp.length;
-    const p = new Float32Array(3 * n), c = new Float32Array(3 * n);
+    if (!lbuf || lbuf.n !== n) lbuf = { n, p: new Float32Array(3 * n), c: new Float32Array(3 * n) };
+    const p = lbuf.p, c = lbuf.c;
     let k = 0;
     const put = (x, y, z, col) => { p[3 * k] = x; p[3 * k + 1] = y; p[3 * k + 2] = z; c[3 * k] = col[0]; c[3 * k + 1] = col[1]; c[3 * k + 2] = col[2]; k++; };
     const node = (i, col) => put(P[3 * i], P[3 * i + 1], P[3 * i + 2], col);
-    const amax = V.mode === "fold" ? range("fold")[1] : 1;
-    for (const e of lineIdx) {
-      let col = MV[ASSIGN[e]] || MV.U;
-      if (V.mode === "fold" && ASSIGN[e] !== "B") { const f = FOLD[s * E + e]; col = cmap("fold", 0.5 + 0.5 * Math.sign(f) * (0.35 + 0.65 * Math.min(1, Math.abs(f) / amax))); }
-      if (ACT.has(e)) col = [0.1, 0.7, 0.2];
-      if (e === V.hover) col = [1, 0.75, 0];
-      node(CR[2 * e], col); node(CR[2 * e + 1], col);
+    const F = V.mode === "fold" ? foldOf(s) : null, amax = F ? range("fold")[1] : 1, L = F ? lut("fold") : null;
+    for (let j = 0; j < lineIdx.length; j++) {  // plain loop: 10^5 creases per state
+      const e = lineIdx[j], a = CR[2 * e], b = CR[2 * e + 1], q = 3 * k;
+      let r = LINE_COL[3 * e], g = LINE_COL[3 * e + 1], bl = LINE_COL[3 * e + 2];
+      if (F && BY_ANGLE[e]) {
+        const f = F[e], t = 0.5 + 0.5 * Math.sign(f) * (0.35 + 0.65 * Math.min(1, Math.abs(f) / amax));
+        const x = 3 * Math.round(255 * t); r = L[x]; g = L[x + 1]; bl = L[x + 2];
+      }
+      if (e === V.hover) { r = 1; g = 0.75; bl = 0; }
+      p[q] = P[3 * a]; p[q + 1] = P[3 * a + 1]; p[q + 2] = P[3 * a + 2];
+      p[q + 3] = P[3 * b]; p[q + 4] = P[3 * b + 1]; p[q + 5] = P[3 * b + 2];
+      c[q] = c[q + 3] = r; c[q + 1] = c[q + 4] = g; c[q + 2] = c[q + 5] = bl;
+      k += 2;
     }
     const nl = k, purple = [0.55, 0.1, 0.6];
     for (const i of loadN) {  // load arrows: a segment along the load, 0.15 radius long at the largest
@@ -282,10 +327,14 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
     if (!gl) return;
     gl.bindBuffer(gl.ARRAY_BUFFER, buf.p); gl.bufferSubData(gl.ARRAY_BUFFER, 0, P);
     gl.bindBuffer(gl.ARRAY_BUFFER, buf.c); gl.bufferSubData(gl.ARRAY_BUFFER, 0, cols);
+    if (!timing.upload) timing.colours = performance.now() - T0;
     lines = lineData(P, V.state);
+    if (!timing.upload) timing.lines = performance.now() - T0;
     gl.bindBuffer(gl.ARRAY_BUFFER, buf.lp); gl.bufferData(gl.ARRAY_BUFFER, lines.p, gl.DYNAMIC_DRAW);
     gl.bindBuffer(gl.ARRAY_BUFFER, buf.lc); gl.bufferData(gl.ARRAY_BUFFER, lines.c, gl.DYNAMIC_DRAW);
+    if (!timing.upload) timing.upload = performance.now() - T0;
     draw();
+    if (!timing.draw) { gl.finish(); timing.draw = performance.now() - T0; }
   }
   function draw() {
     if (!gl) return;
@@ -305,6 +354,7 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
     gl.drawArrays(gl.LINES, 0, lines.nl + lines.nLoad);
     if (lines.np) gl.drawArrays(gl.POINTS, lines.nl + lines.nLoad, lines.np);
     gl.bindVertexArray(null);
+    V.drawn = cv.width * cv.height;  // pixels of the last drawing (0 before layout)
   }
 
   // camera: left drag orbits, right drag or shift-drag pans, wheel zooms
@@ -340,9 +390,25 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
     const [x0, y0] = tr(CR[2 * e]), [x1, y1] = tr(CR[2 * e + 1]);
     g.moveTo(x0, y0); g.lineTo(x1, y1);
   }
+  function rasterLines(img, tr, dpr, list, col) {  // DDA lines into RGBA pixels
+    const px = img.data, W = img.width, H = img.height;
+    const R = Math.round(255 * col[0]), G = Math.round(255 * col[1]), Bc = Math.round(255 * col[2]);
+    for (const e of list) {
+      const a = tr(CR[2 * e]), b = tr(CR[2 * e + 1]);
+      const x0 = a[0] * dpr, y0 = a[1] * dpr, dx = b[0] * dpr - x0, dy = b[1] * dpr - y0;
+      const n = Math.max(1, Math.ceil(Math.max(Math.abs(dx), Math.abs(dy))));
+      for (let t = 0; t <= n; t++) {
+        const x = Math.round(x0 + (dx * t) / n), y = Math.round(y0 + (dy * t) / n);
+        if (x < 0 || y < 0 || x >= W || y >= H) continue;
+        const i = 4 * (y * W + x);
+        px[i] = R; px[i + 1] = G; px[i + 2] = Bc; px[i + 3] = 255;
+      }
+    }
+  }
   function drawCP() {
     const dpr = window.devicePixelRatio || 1, w = cpc.clientWidth, h = cpc.clientHeight;
     const W = Math.round(w * dpr), H = Math.round(h * dpr);
+    if (!W || !H) return;  // not laid out yet (a hidden or collapsed frame): drawn on resize
     const tr = cpTransform();
     if (!cpBase || cpBase.width !== W || cpBase.height !== H) {
       cpBase = document.createElement("canvas"); cpBase.width = W; cpBase.height = H;
@@ -353,12 +419,23 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
         if (!groups.has(k)) groups.set(k, []);
         groups.get(k).push(e);
       }
+      // many creases: one pixel wide lines set straight into the image (a canvas strokes
+      // 10^5 segments in seconds in a software renderer); actuators stroked on top
+      const raster = E > 5000, img = raster ? g.createImageData(W, H) : null;
       for (const [k, list] of groups) {
         const col = k === "act" ? [0.1, 0.7, 0.2] : MV[k] || MV.U;
+        if (raster && k !== "act") { rasterLines(img, tr, dpr, list, col); continue; }
         g.strokeStyle = `rgb(${col.map((x) => Math.round(255 * x)).join(",")})`;
-        g.lineWidth = k === "act" ? 2.5 : E > 5000 ? 0.6 : 1.4;
-        g.setLineDash(k === "M" && E <= 5000 ? [6, 3] : []);
+        g.lineWidth = k === "act" ? 2.5 : 1.4;
+        g.setLineDash(k === "M" ? [6, 3] : []);
+        if (raster) continue;
         g.beginPath(); for (const e of list) strokeCrease(g, tr, e); g.stroke();
+      }
+      if (raster) {
+        g.putImageData(img, 0, 0);
+        const act = groups.get("act") || [];
+        g.strokeStyle = "rgb(26,179,51)"; g.lineWidth = 2.5; g.setLineDash([]);
+        g.beginPath(); for (const e of act) strokeCrease(g, tr, e); g.stroke();
       }
     }
     cpc.width = W; cpc.height = H;
@@ -382,7 +459,7 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
   function fmt(x, d) { if (Number.isInteger(x)) return String(x); return Number.isFinite(x) ? (Math.abs(x) >= 1e4 || (Math.abs(x) < 1e-3 && x !== 0) ? x.toExponential(d - 1) : x.toPrecision(d)) : "\u2013"; }
   const NAMES = { M: "mountain", V: "valley", B: "boundary", F: "flat", U: "unassigned", C: "cut" };
   function tipText(e) {
-    const s = V.state, f = FOLD[s * E + e], m = MOM ? MOM[s * E + e] : NaN;
+    const s = V.state, f = foldOf(s)[e], m = HAS_M ? momOf(s)[e] : NaN;
     return `crease ${e}${ACT.has(e) ? " (actuator)" : ""}\nassignment ${ASSIGN[e]} (${NAMES[ASSIGN[e]] || "?"})\nfold angle ${f.toFixed(2)}\u00b0\nmoment ${fmt(m, 4)}`;
   }
   function hover(e) {
@@ -473,7 +550,10 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
     play.textContent = "\u275a\u275a pause";
     timer = setInterval(() => setState(V.state >= S - 1 ? 0 : V.state + 1), Math.max(40, 3000 / S));
   });
-  window.addEventListener("resize", () => { drawCP(); drawBar(); drawCharts(); draw(); });
+  const redraw = () => { if (V.ready) { drawCP(); drawBar(); drawCharts(); draw(); } };
+  window.addEventListener("resize", redraw);
+  // a frame laid out after the script ran (Jupyter output, a hidden tab) has no window resize
+  if (window.ResizeObserver) { const ro = new ResizeObserver(redraw); ro.observe(cv); ro.observe(cpc); }
 
   const sum = document.getElementById("summary");
   for (const [k, v] of Object.entries(D.summary)) {
@@ -494,8 +574,9 @@ window.addEventListener("error", (e) => {  // say it on the page too, not only i
   // for tests and scripts: drive the viewer and read what it shows
   window.barhingeViewer = {
     get state() { return V.state; }, get mode() { return V.mode; }, get ready() { return V.ready; },
+    get drawn() { return V.drawn || 0; },
     modes: Object.keys(MODES), setState, setMode, field: (m, s) => Array.from(MODES[m].f(s)),
     creasePoint: (e) => { const tr = cpTransform(), a = tr(CR[2 * e]), b = tr(CR[2 * e + 1]); return [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2]; },
-    camera: cam, timing,
+    camera: cam, timing, positions: (s) => Array.from(pos(s)), eps: EPS,
   };
 })();

@@ -51,8 +51,8 @@ def default_scene_pictures() -> None:
 def poisson_pictures() -> None:
     alpha = 60.0
     theta = np.linspace(5.0, 85.0, 33)
-    X = np.array([bh.patterns.miura(3, 3, alpha=alpha, fold=t).vertices3d for t in theta])
-    px, py = grid_pairs(bh.patterns.miura(3, 3, alpha=alpha, fold=5.0))
+    X = np.array([bh.families.miura(3, 3, alpha=alpha, fold=t).vertices3d for t in theta])
+    px, py = grid_pairs(bh.families.miura(3, 3, alpha=alpha, fold=5.0))
     res = periodic_poisson(X, py, px, parameter=np.radians(theta))
     fine = np.linspace(5.0, 85.0, 200)
     ref = -(np.cos(np.radians(fine)) ** 2) * np.tan(np.radians(alpha)) ** 2
@@ -68,7 +68,7 @@ def poisson_pictures() -> None:
 
 def saddle_picture() -> None:
     theta, alpha = 45.0, 60.0
-    cp = bh.patterns.miura(6, 6, alpha=alpha, fold=theta)
+    cp = bh.families.miura(6, 6, alpha=alpha, fold=theta)
     model = bh.BarHingeModel.from_pattern(
         cp, scheme="N4B5", stiffness_ratio=1e3, material=bh.Material(E=1e6, nu=1 / 3, t=0.01)
     )

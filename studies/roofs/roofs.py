@@ -11,7 +11,7 @@ span (vertices at the flat pattern's extreme coordinate along the span), pinned 
 Folded states
 -------------
 * ``miura`` (sector angle 60 and 75 deg), ``miura_arc``, ``yoshimura``: the exact rigidly
-  folded states of ``bh.patterns`` (``fold=``).
+  folded states of ``bh.families`` (``fold=``).
 * ``pleats``: a corrugation with panels subdivided into ``n_strip`` strips across and segments
   along the span (:func:`corrugation`; flat ``F`` lines, stiffness ``D l / s``, see there).
 * ``resch``, ``waterbomb``: these patterns are not rigidly foldable along their target
@@ -112,7 +112,7 @@ def corrugation(
     n_strip: int = 1,
     flat: bool = False,
 ):
-    """Straight pleats (as ``bh.patterns.pleats``, exact folded state, creases along y) with
+    """Straight pleats (as ``bh.families.pleats``, exact folded state, creases along y) with
     each of the ``n`` panels cut into ``n_strip`` strips along y and ``m_seg`` segments across,
     by flat ``F`` lines so that a panel's in-plane bending and the span are resolved.
 
@@ -238,7 +238,7 @@ def folded(family: str, state: float, **override):
         cp, crease = corrugation(fold=state, length=SPAN, **kw)
         flat, _ = corrugation(fold=0.0, length=SPAN, **kw)
         return cp, np.asarray(flat.vertices)[:, :2], crease
-    fn = bh.patterns.FAMILIES[gen]
+    fn = bh.families.FAMILIES[gen]
     flat_cp = fn(**kw)
     if gen in ("resch", "waterbomb"):
         X = _formed(flat_cp, state)

@@ -207,7 +207,7 @@ def plate_table() -> str:
     ]
     for p in PLATE:
         lines.append(
-            f"| {p['n_strip']} | {'rigid' if p['rigid_panels'] else 'N5B8 (F17)'} | "
+            f"| {p['n_strip']} | {'rigid' if p['rigid_panels'] else 'N5B8'} | "
             f"{p['stiffness_per_width']:.1f} | {p['plate']:.1f} | {p['beam']:.1f} | "
             f"{p['stiffness_per_width'] / p['plate']:.3f} |"
         )

@@ -29,6 +29,10 @@ import scenes  # noqa: E402
 
 MAIN = __name__ == "__main__"
 QUICK = not MAIN or "--quick" in sys.argv
+#: load-step counts of the converged roof runs whose median is the roof's reference
+ROOF_REFERENCE_STEPS = (1, 8, 32, 64)
+#: spread of each reference's runs over its value (filled by the run)
+REFERENCE_SPREAD: dict[str, float] = {}
 REPEAT = 1 if QUICK else 5
 TARGET = 1e-2  # relative error a user asks for when choosing the model
 FLOOR = 1e-16  # errors below this are plotted at it
@@ -39,7 +43,8 @@ ROOT = HERE.parents[1]
 # (method, steps, tol, ratio); ratio None = model as calibrated
 if QUICK:
     MIURA_RIGID_STEPS = [4, 8, 16, 32]
-    MIURA_RATIOS = [10.0, 100.0, 1000.0]
+    # the 1/r regime starts near r = 100 with the plate-calibrated panel bending (default)
+    MIURA_RATIOS = [100.0, 1000.0, 10000.0]
     GRID_MIURA = [("rigid", s, 1e-13, None) for s in MIURA_RIGID_STEPS]
     GRID_MIURA += [("N5B8", 8, 1e-8, r) for r in MIURA_RATIOS]
     YOSHI_RATIOS = [10.0, 100.0, 1000.0]
@@ -49,7 +54,7 @@ if QUICK:
     GRID_ROOF += [("N4B5", 1, 1e-8)]
 else:
     MIURA_RIGID_STEPS = [4, 8, 16, 32, 64]
-    MIURA_RATIOS = [1.0, 10.0, 100.0, 1000.0]
+    MIURA_RATIOS = [1.0, 10.0, 100.0, 1000.0, 10000.0]
     GRID_MIURA = [("rigid", s, 1e-13, None) for s in MIURA_RIGID_STEPS]
     GRID_MIURA += [("rigid", 16, 1e-6, None)]
     for m in ("N4B5", "N5B8"):
@@ -95,7 +100,11 @@ def run_all() -> list[dict]:
             }
         )
     q = scenes.roof_load_scale()
-    ref = scenes.roof_run("N5B8", 64, 1e-12, q)["value"]
+    # reference: the median of converged runs at tolerance 1e-12 with several load-step counts
+    # (the soft roof's equilibrium is ill-conditioned: one count may stop up to ~1e-7 away)
+    refs = [scenes.roof_run("N5B8", n, 1e-12, q)["value"] for n in ROOF_REFERENCE_STEPS]
+    ref = float(np.median(refs))
+    REFERENCE_SPREAD["roof"] = float((max(refs) - min(refs)) / abs(ref))
     for method, steps, tol in GRID_ROOF:
         rec = _timed(scenes.roof_run, method, steps, tol, q, ref)
         records.append(
@@ -274,6 +283,8 @@ if MAIN:
             print(f" {on} {label(r):32s} error {r['error']:9.2e}  time {r['time_s']:7.3f} s")
         nd = NEEDS[s]
         print(f"  needs (error <= {TARGET:g}): {label(nd) if nd else 'nothing reaches it'}")
+        if s in REFERENCE_SPREAD:
+            print(f"  reference spread over {ROOF_REFERENCE_STEPS} steps: {REFERENCE_SPREAD[s]:.1e}")
     print("\n| scene | model it needs (error <= 1 %) | Pareto front: run, error, median time |")
     print("|---|---|---|")
     for s in SCENES:

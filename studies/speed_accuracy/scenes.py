@@ -15,7 +15,7 @@ Scenes and their references
 * ``yoshimura``: a 4 x 3 Yoshimura arch folded from fold = 5 to 30 deg by the 12 actuators
   that ``bh.dof`` suggests (the pattern has 12 rigid DOF). Quantity: the folded form, RMS
   vertex distance after best-fit rigid alignment (Kabsch) divided by the arch's size.
-  Reference: the closed-form rigidly folded arch ``bh.patterns.yoshimura(fold=30)`` (rows are
+  Reference: the closed-form rigidly folded arch ``bh.families.yoshimura(fold=30)`` (rows are
   regular polygons of circumradius ``w / (2 sin beta)`` spaced ``sqrt(h^2 - (w/2)^2
   tan^2(beta/2))``).
 * ``roof``: a 3 x 3 Miura roof folded to facet angle 45 deg, pinned along its two edges
@@ -62,7 +62,7 @@ def kabsch_rms(X: np.ndarray, Y: np.ndarray) -> float:
 # ------------------------------------------------------------------------------ Miura
 def miura_dims(X: np.ndarray, n: int = MIURA_N) -> tuple[float, float]:
     """Cell half-length L (x) and half-width S (y) from the middle row / column of an
-    n x n Miura sheet (vertex (i, j) has id j (2 n + 1) + i; see ``bh.patterns.miura``)."""
+    n x n Miura sheet (vertex (i, j) has id j (2 n + 1) + i; see ``bh.families.miura``)."""
     ni = nj = 2 * n + 1
     vid = lambda i, j: j * ni + i  # noqa: E731
     L = np.linalg.norm(X[vid(ni - 1, n)] - X[vid(0, n)]) / (2 * n)
@@ -84,12 +84,12 @@ def miura_run(method: str, steps: int, tol: float, ratio: float | None = None) -
     tolerance or the solver's force and displacement tolerance; ``ratio``: stiffness ratio of
     bars and panels (bar-and-hinge only)."""
     import barhinge as bh
+    from barhinge.families import miura_line_creases
     from barhinge.kinematics.path import RigidOptions
-    from barhinge.scene import miura_line_creases
 
     t0 = time.perf_counter()
-    cp0 = bh.patterns.miura(MIURA_N, MIURA_N, alpha=GAMMA, fold=TH0)
-    rho1 = np.asarray(bh.patterns.miura(MIURA_N, MIURA_N, alpha=GAMMA, fold=TH1).fold_angles)
+    cp0 = bh.families.miura(MIURA_N, MIURA_N, alpha=GAMMA, fold=TH0)
+    rho1 = np.asarray(bh.families.miura(MIURA_N, MIURA_N, alpha=GAMMA, fold=TH1).fold_angles)
     edges = miura_line_creases(cp0)
     if method == "rigid":
         opts = RigidOptions(tol=tol, check_rank=False)
@@ -105,7 +105,7 @@ def miura_run(method: str, steps: int, tol: float, ratio: float | None = None) -
     nu = nu_from_path(X)
     L, S = miura_dims(X[-1])
     elapsed = time.perf_counter() - t0
-    g = bh.patterns.miura_geometry(1.0, 1.0, GAMMA, TH1)
+    g = bh.families.miura_geometry(1.0, 1.0, GAMMA, TH1)
     return {
         "error": abs(nu - g.nu_SL) / abs(g.nu_SL),
         "time_s": elapsed,
@@ -120,7 +120,7 @@ def yoshimura_actuators() -> np.ndarray:
     """Edge ids of the 12 actuators ``bh.dof`` suggests at the start state."""
     import barhinge as bh
 
-    return np.asarray(bh.dof(bh.patterns.yoshimura(**YOSHI, fold=FOLD0)).actuators)
+    return np.asarray(bh.dof(bh.families.yoshimura(**YOSHI, fold=FOLD0)).actuators)
 
 
 def yoshimura_run(
@@ -131,8 +131,8 @@ def yoshimura_run(
     from barhinge.kinematics.path import RigidOptions
 
     t0 = time.perf_counter()
-    cp0 = bh.patterns.yoshimura(**YOSHI, fold=FOLD0)
-    cp1 = bh.patterns.yoshimura(**YOSHI, fold=FOLD1)
+    cp0 = bh.families.yoshimura(**YOSHI, fold=FOLD0)
+    cp1 = bh.families.yoshimura(**YOSHI, fold=FOLD1)
     rho1 = np.asarray(cp1.fold_angles)
     edges = yoshimura_actuators() if edges is None else edges
     if method == "rigid":
@@ -159,7 +159,7 @@ def roof_setup(scheme: str):
     import barhinge as bh
     from barhinge.scene import select_vertices, self_weight
 
-    cp = bh.patterns.miura(MIURA_N, MIURA_N, alpha=GAMMA, fold=ROOF_THETA)
+    cp = bh.families.miura(MIURA_N, MIURA_N, alpha=GAMMA, fold=ROOF_THETA)
     model = bh.BarHingeModel.from_pattern(cp, scheme, _material())
     S = np.zeros((model.n_nodes, 3), bool)
     S[select_vertices(model, "bottom")] = True
@@ -174,7 +174,7 @@ def roof_span() -> float:
     return float(
         np.ptp(
             np.asarray(
-                bh.patterns.miura(MIURA_N, MIURA_N, alpha=GAMMA, fold=ROOF_THETA).vertices3d
+                bh.families.miura(MIURA_N, MIURA_N, alpha=GAMMA, fold=ROOF_THETA).vertices3d
             )[:, 1]
         )
     )

@@ -311,7 +311,7 @@ def flat_rigid_branch() -> Outcome:
 
 
 def flat_dof() -> Outcome:
-    rep = bh.dof(bh.patterns.miura(3, 3))
+    rep = bh.dof(bh.families.miura(3, 3))
     fold = rep.folded.global_dof if rep.folded is not None else rep.global_dof
     if rep.global_dof != fold:
         return Outcome(
@@ -364,8 +364,8 @@ def flat_barhinge_soft() -> Outcome:
     """A 6 x 6 Miura sheet whose panels are only 100 x the default stiffness, driven by one
     crease from flat: the panels bend rather than fold the far creases, which then fold
     against their assignment; the run must say so."""
-    cp = bh.patterns.miura(6, 6, alpha=60.0)
-    z = int(bh.patterns.miura_layout(6, 6).interior_zigzag_edges[0])
+    cp = bh.families.miura(6, 6, alpha=60.0)
+    z = int(bh.families.miura_layout(6, 6).interior_zigzag_edges[0])
     model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=MAT, stiffness_ratio=1e2)
     acts = bh.Actuators(edges=[z], targets_deg=[0.5 * cp.fold_angles[z]])
     path, out = _solve(bh.Scene(model, actuators=acts, steps=6))
@@ -386,7 +386,7 @@ def flat_barhinge_soft() -> Outcome:
 def _miura_cell_scene(target: float, steps: int, cutbacks: int = 8, **model_kw) -> bh.Scene:
     # starts folded (10 deg): from the flat state the rigid-fold predictor would place the
     # first increment exactly, and this scenario is about Newton's own reach
-    cp = bh.patterns.miura(1, 1, alpha=60.0, fold=10.0)
+    cp = bh.families.miura(1, 1, alpha=60.0, fold=10.0)
     kw = {"stiffness_ratio": 1e3, **model_kw}
     model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=MAT, **kw)
     return bh.Scene(
@@ -415,7 +415,7 @@ def large_step(cutbacks: int) -> Outcome:
 
 # ------------------------------------------------------------------ soft/stiff folds
 def soft_folds() -> Outcome:
-    cp = bh.patterns.miura(2, 2, alpha=60.0)
+    cp = bh.families.miura(2, 2, alpha=60.0)
     model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=MAT, fold_stiffness=0.0)
     scene = bh.Scene(
         model,
@@ -455,7 +455,7 @@ def stiff_folds() -> Outcome:
 
 # ---------------------------------------------------------------- near flat-folded
 def rigid_near_flat(target: float) -> Outcome:
-    cp = bh.patterns.miura(1, 1, alpha=60.0)
+    cp = bh.families.miura(1, 1, alpha=60.0)
     try:
         path = bh.rigid_fold(cp, [7], targets_deg=[target], steps=20)
     except ConvergenceError as exc:

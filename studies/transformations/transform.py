@@ -21,7 +21,7 @@ import numpy as np
 BASE_DEG = 30.0
 MATERIAL = {"E": 1e6, "nu": 0.3, "t": 0.01}
 
-# name -> (module of barhinge.patterns, generator, keyword arguments quick, full)
+# name -> (module of barhinge.families, generator, keyword arguments quick, full)
 PATTERNS: dict[str, tuple[str, str, dict, dict]] = {
     "miura": ("miura", "miura", {"nx": 3, "ny": 3}, {"nx": 5, "ny": 5}),
     "miura_arc": ("miura_arc", "miura_arc", {"nx": 3, "ny": 3}, {"nx": 5, "ny": 4}),
@@ -44,7 +44,7 @@ ENERGY_MAX_ITER = 200
 def make_pattern(name: str, quick: bool):
     """The flat crease pattern of a study pattern (quick or full size)."""
     module, func, kq, kf = PATTERNS[name]
-    gen = getattr(importlib.import_module(f"barhinge.patterns.{module}"), func)
+    gen = getattr(importlib.import_module(f"barhinge.families.{module}"), func)
     return gen(**(kq if quick else kf))
 
 
@@ -55,7 +55,7 @@ def make_curve(curve: str, kappa: float, L: float):
     cubic spline through five points of the lopsided parabola ``z = kappa x^2 (1 + x / L) / 2``
     (curvature ``kappa`` at the apex, ``2 kappa`` at the +x end, 0 at the -x end).
     """
-    from barhinge.control import CircularArc, Parabola, SplineCurve
+    from barhinge.actuators.curves import CircularArc, Parabola, SplineCurve
 
     if curve == "circle":
         return CircularArc(kappa)
@@ -103,7 +103,7 @@ def rigid_weights(cp) -> np.ndarray:
     """(n_edges,) fold-spring stiffness of the bar-and-hinge model per edge, normalised to a
     largest crease value of 1 (the rigid limit of that model; the energy minimum does not
     depend on the scale)."""
-    from barhinge.solve.branch import fold_weights
+    from barhinge.solver.branch import fold_weights
 
     w, _ = fold_weights(_model(cp, None))
     return w / float(w[cp.crease_edges].max())
@@ -123,7 +123,7 @@ def rigid_limit(cp, acts, steps: int):
 def _targets(cp, spacing: int, curve: str, kappa_L: float, ky_L: float | None):
     """Actuators of one cell: base fold s_i * BASE_DEG plus the control rotation angles."""
     import barhinge as bh
-    from barhinge.control import (
+    from barhinge.actuators.curves import (
         ControlSurface,
         curve_angles_deg,
         section_crossings,
@@ -210,7 +210,7 @@ def point(
 def section_placement(cp, count: int) -> np.ndarray:
     """``count`` creases along the two middle section lines: evenly spaced crossings of the
     line along x, then (beyond its crossings) of the line along y."""
-    from barhinge.control import section_crossings
+    from barhinge.actuators.curves import section_crossings
 
     ex = section_crossings(cp)[0]
     ey = section_crossings(cp, direction=(0.0, 1.0))[0]

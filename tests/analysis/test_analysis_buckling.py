@@ -41,7 +41,7 @@ def _strip(n: int, ell: float = 1.0, b: float = 0.5, k: float = 2.0, rigid: floa
 
 
 def test_stiffness_parts_sum_to_the_tangent():
-    cp = bh.patterns.miura(2, 2, fold=50.0)
+    cp = bh.families.miura(2, 2, fold=50.0)
     m = bh.BarHingeModel.from_pattern(cp, "N5B8", bh.Material(E=1e3, nu=0.3, t=0.01))
     rng = np.random.default_rng(0)
     X = m.X0 + 0.01 * rng.standard_normal(m.X0.shape)

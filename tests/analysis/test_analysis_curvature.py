@@ -149,7 +149,7 @@ def test_bad_input_is_a_config_error():
 
 def test_rigidly_folded_miura_has_zero_angle_defect():
     """Rigid folding is an isometry of every panel: the defects stay zero (to round-off)."""
-    patterns = pytest.importorskip("barhinge.patterns")
+    patterns = pytest.importorskip("barhinge.families")
     for theta in (20.0, 45.0, 70.0):
         cp = patterns.miura(4, 4, a=1.0, b=1.0, alpha=60.0, fold=theta)
         res = bh.gaussian_curvature(cp.vertices3d, pattern=cp)

@@ -60,7 +60,7 @@ def test_bar_forces_and_reactions_of_a_triangle_truss_match_statics():
 
 
 def _miura_scene(case: str):
-    cp = bh.patterns.miura(3, 3, fold=50.0)
+    cp = bh.families.miura(3, 3, fold=50.0)
     m = bh.BarHingeModel.from_pattern(cp, "N5B8", bh.Material(E=1e6, nu=0.3, t=0.01))
     S = np.zeros((m.n_nodes, 3), bool)
     S[select_vertices(m, "left")] = True
@@ -109,7 +109,7 @@ def test_reactions_balance_the_loads_at_solved_states(case):
 def test_hinge_moments_are_the_energy_derivative():
     """``M = dW/d rho = k (rho - rho0)``: central differences of each hinge's energy against
     its angle along a random direction (error O(h^2) ~ 1e-10 relative)."""
-    cp = bh.patterns.miura(2, 2, fold=40.0)
+    cp = bh.families.miura(2, 2, fold=40.0)
     m = bh.BarHingeModel.from_pattern(cp, "N5B8", bh.Material(E=1e6, nu=0.3, t=0.01))
     rng = np.random.default_rng(3)
     X = m.X0 + 0.02 * rng.standard_normal(m.X0.shape)
@@ -139,7 +139,7 @@ def test_panel_resultants_of_a_homogeneous_deformation_are_exact(scheme):
     (``P`` its frame); the resultant must be the plane-stress ``t C E`` exactly (closed form,
     Timoshenko & Goodier, plane stress), also for a folded sheet and with bars whose own
     calibration is not exact."""
-    cp = bh.patterns.miura(2, 2, fold=35.0)
+    cp = bh.families.miura(2, 2, fold=35.0)
     mat = bh.Material(E=2e5, nu=0.3, t=0.02)
     m = bh.BarHingeModel.from_pattern(cp, scheme, mat)
     rng = np.random.default_rng(1)

@@ -16,16 +16,16 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from barhinge import patterns
+from barhinge import families
 from barhinge.analysis.periodic import periodic_cell
 from barhinge.errors import ConfigError
+from barhinge.families.miura import miura_geometry
 from barhinge.model.model import BarHingeModel
-from barhinge.patterns.miura import miura_geometry
 
 
 def _cell(a, b, gam, th, scheme="N5B8", n=2, **model_kw):
     g = miura_geometry(a, b, gam, th)
-    cp = patterns.miura(n, n, a=a, b=b, alpha=gam, fold=th)
+    cp = families.miura(n, n, a=a, b=b, alpha=gam, fold=th)
     model = BarHingeModel.from_pattern(cp, scheme, **model_kw)
     return g, model, [[2 * g.L, 0, 0], [0, 2 * g.S, 0]]
 
@@ -84,12 +84,12 @@ def test_result_does_not_depend_on_the_sheet_cut_and_glide_symmetry_removes_coup
     ref = periodic_cell(model, T)
     scale = np.abs(ref.ABD).max()
     for nx, ny in ((3, 2), (3, 3)):
-        cp = patterns.miura(nx, ny, a=1.0, b=1.5, alpha=60.0, fold=50.0)
+        cp = families.miura(nx, ny, a=1.0, b=1.5, alpha=60.0, fold=50.0)
         c = periodic_cell(BarHingeModel.from_pattern(cp, "N5B8"), T)
         np.testing.assert_allclose(c.ABD, ref.ABD, rtol=0, atol=1e-11 * scale)
     assert ref.z0 == pytest.approx(g.H / 2, rel=1e-12)
     assert np.abs(ref.B).max() < 1e-12 * scale
-    cp = patterns.miura(2, 2, a=1.0, b=1.5, alpha=60.0, fold=50.0)
+    cp = families.miura(2, 2, a=1.0, b=1.5, alpha=60.0, fold=50.0)
     mirrored = BarHingeModel.from_pattern(cp.replaced(vertices=cp.vertices * [1, 1, -1]), "N5B8")
     np.testing.assert_allclose(periodic_cell(mirrored, T).ABD, ref.ABD, rtol=0, atol=1e-11 * scale)
     # symmetric, positive definite (finite fold stiffness: no periodic mechanism)
@@ -101,7 +101,7 @@ def _kinematic_sheet_abd(n: int, z0: float, area: float) -> np.ndarray:
     """ABD of an n x n-cell Miura sheet with the macroscopic field prescribed on every
     boundary vertex and the interior free (energy per projected area of n^2 cells); built
     from the sheet's tangent only."""
-    cp = patterns.miura(n, n, a=1.0, b=1.5, alpha=60.0, fold=50.0)
+    cp = families.miura(n, n, a=1.0, b=1.5, alpha=60.0, fold=50.0)
     m = BarHingeModel.from_pattern(cp, "N5B8")
     X = m.X0
     x, y, _ = (X - X.mean(0)).T
@@ -141,43 +141,32 @@ def test_large_finite_sheet_tends_to_the_periodic_cell_at_rate_one_over_n():
     assert rel[-1, :5].max() < 0.07  # A and the two bending terms within 7 % at 16 x 16
 
 
-def _free_sheet_centre_strain(n: int, d: int, g) -> np.ndarray:
-    """(eps_x, eps_y) at the centre cell of an n x n-cell Miura sheet (a=1, b=1.5, gamma=60,
-    theta=50, N5B8) under a unit stress resultant along x (d = 0) or y (d = 1), applied as
-    equal nodal forces on the two end columns (x) / end rows (y) so that the resultant acts
-    near the mid-plane; free edges, 3-2-1 restraint (self-equilibrated, no reactions).
-    eps_x averages the pairs of both layers (mid-plane)."""
-    from barhinge.analysis.stiffness import linear_response
-    from barhinge.scene import restraint_321
+def _periodic_table():
+    """scripts/periodic_table.py, the script that writes docs/periodic.md's tables."""
+    import importlib.util
+    from pathlib import Path
 
-    cp = patterns.miura(n, n, a=1.0, b=1.5, alpha=60.0, fold=50.0)
-    m = BarHingeModel.from_pattern(cp, "N5B8")
-    ni = 2 * n + 1
-    vid = np.arange(ni * ni).reshape(ni, ni)  # vid[j, i]
-    if d == 0:
-        width, e0, e1 = 2 * n * g.S, np.r_[vid[:, 0], vid[:, 1]], np.r_[vid[:, -1], vid[:, -2]]
-    else:
-        width, e0, e1 = 2 * n * g.L, vid[0, :], vid[-1, :]
-    f = np.zeros((m.n_nodes, 3))
-    f[e0, d] -= width / len(e0)
-    f[e1, d] += width / len(e1)
-    U, _ = linear_response(m, f, restraint_321(m))
-    i0 = j0 = n - 1
-    ex = np.mean([U[vid[j0 : j0 + 3, i + 2], 0] - U[vid[j0 : j0 + 3, i], 0] for i in (i0, i0 + 1)])
-    ey = np.mean(U[vid[j0 + 2, i0 : i0 + 3], 1] - U[vid[j0, i0 : i0 + 3], 1])
-    return np.array([ex / (2 * g.L), ey / (2 * g.S)])
+    path = Path(__file__).resolve().parents[2] / "scripts" / "periodic_table.py"
+    spec = importlib.util.spec_from_file_location("periodic_table", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
 
 
 def test_free_edge_sheet_centre_tends_to_the_periodic_compliance_at_rate_one_over_n():
     """Static check, free edges: under a uniform end load the centre cell of an n x n sheet
     strains as the periodic compliance column (a_1d, a_2d) predicts, with an error that falls
     like 1/n (measured at n = 8, 16, 32 for force along x: eps_x 5.2 %, 2.8 %, 1.4 %)."""
+    # centre_strain: an n x n-cell Miura sheet (a=1, b=1.5, gamma=60, theta=50, N5B8) under a
+    # unit stress resultant along x (d = 0) or y (d = 1), equal nodal forces on the two end
+    # columns / rows, free edges, 3-2-1 restraint; eps_x averages both layers (mid-plane)
+    centre_strain = _periodic_table().centre_strain
     g, model, T = _cell(1.0, 1.5, 60.0, 50.0)
     a = periodic_cell(model, T).in_plane_compliance(free_curvature=True)
     ns = np.array([8, 16, 32])
     signed = []
     for d in (0, 1):
-        e = np.array([_free_sheet_centre_strain(n, d, g) / a[:2, d] - 1 for n in ns])
+        e = np.array([centre_strain(n, d) / a[:2, d] - 1 for n in ns])
         signed.append(e)
         slopes = np.polyfit(np.log(ns), np.log(np.abs(e)), 1)[0]
         assert np.all(slopes == pytest.approx(-1.0, abs=0.3)), slopes
@@ -202,7 +191,7 @@ def test_bad_input_is_a_config_error():
         periodic_cell(model, [[2 * g.L * 1.01, 0, 0], [0, 2 * g.S, 0]])
     with pytest.raises(ConfigError, match="shape"):
         periodic_cell(model, [1.0, 2.0])
-    one = BarHingeModel.from_pattern(patterns.miura(1, 1, a=1.0, b=1.5, alpha=60.0, fold=50.0))
+    one = BarHingeModel.from_pattern(families.miura(1, 1, a=1.0, b=1.5, alpha=60.0, fold=50.0))
     with pytest.raises(ConfigError, match="2 x 2 periods"):
         periodic_cell(one, T)
 
@@ -211,7 +200,6 @@ def test_docs_example_runs_and_the_doc_table_matches_the_script():
     """docs/periodic.md: its example runs and gives the Schenk & Guest ratio's neighbourhood
     at the default material (folds soft against the panels: within 1e-3); its tables are
     the output of scripts/periodic_table.py (up to the date stamp)."""
-    import importlib.util
     import re
     from pathlib import Path
 
@@ -221,11 +209,7 @@ def test_docs_example_runs_and_the_doc_table_matches_the_script():
     ns: dict = {"__name__": "periodic_doc", "print": lambda *a, **k: None}
     exec(compile(block.group(1), "docs/periodic.md", "exec"), ns)
     assert ns["cell"].moduli()["nu21"] == pytest.approx(ns["g"].nu_SL, rel=1e-3)
-    spec = importlib.util.spec_from_file_location(
-        "periodic_table", root / "scripts" / "periodic_table.py"
-    )
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    mod = _periodic_table()
     ex, slopes, moduli = mod.sheet_rows()
     table = mod.render(mod.limit_rows(), ex, slopes, moduli)  # Table 3 is checked above
     body = text[text.index(mod.START) + len(mod.START) : text.index(mod.END)]

@@ -16,7 +16,7 @@ from barhinge.analysis.poisson import (
 )
 from barhinge.errors import ConfigError
 
-patterns = pytest.importorskip("barhinge.patterns")
+patterns = pytest.importorskip("barhinge.families")
 
 
 def _miura_path(n: int, alpha: float = 60.0):

@@ -150,7 +150,7 @@ def test_v_folded_plate_approaches_the_folded_plate_beam_estimate():
 def test_soft_modes_count_the_bar_frameworks_mechanisms():
     """Soft modes (no bar stretching) = dimension of the null space of the bar framework's
     rigidity matrix, computed independently by SVD."""
-    cp = bh.patterns.miura(2, 2, fold=40.0)
+    cp = bh.families.miura(2, 2, fold=40.0)
     model = bh.BarHingeModel.from_pattern(cp, material=bh.Material(E=1e6, nu=NU, t=0.01))
     X = model.X0
     B = model.bars
@@ -171,7 +171,7 @@ def test_soft_modes_count_the_bar_frameworks_mechanisms():
 
 
 def test_shift_invert_agrees_with_dense_eigensolver():
-    cp = bh.patterns.miura(6, 5, fold=50.0)
+    cp = bh.families.miura(6, 5, fold=50.0)
     model = bh.BarHingeModel.from_pattern(cp, material=bh.Material(E=1e6, nu=NU, t=0.01))
     from barhinge.scene import restraint_321
 
@@ -180,12 +180,16 @@ def test_shift_invert_agrees_with_dense_eigensolver():
     assert modes.n_free > 600  # the sparse path
     free = np.flatnonzero(~fixed.ravel())
     Kd = tangent_stiffness(model).toarray()[np.ix_(free, free)]
-    ref = np.linalg.eigvalsh(0.5 * (Kd + Kd.T))[:5]
-    np.testing.assert_allclose(modes.eigenvalues, ref, rtol=1e-8)
+    lam = np.linalg.eigvalsh(0.5 * (Kd + Kd.T))
+    ref = lam[:5]
+    # the dense reference is backward stable: its eigenvalues are exact to O(eps |K|_2)
+    # (Weyl), 1.3e-11 here, 7e-8 of the softest mode with the plate-calibrated panels
+    eps_ref = np.finfo(float).eps * lam[-1]
+    np.testing.assert_allclose(modes.eigenvalues, ref, rtol=1e-8, atol=eps_ref)
 
 
 def test_mechanism_is_reported():
-    cp = bh.patterns.miura(1, 1, fold=40.0)
+    cp = bh.families.miura(1, 1, fold=40.0)
     model = bh.BarHingeModel.from_pattern(cp, material=bh.Material(E=1e6, nu=NU, t=0.01))
     model = model.with_(hinge_k=np.zeros(model.n_hinges))
     fixed = np.zeros((model.n_nodes, 3), bool)

@@ -188,9 +188,9 @@ def _npz_bytes(**arrays: object) -> bytes:
 @pytest.fixture(scope="session")
 def d(tmp_path_factory) -> Path:
     """The folder of malformed inputs (and a few valid ones to point bad options at)."""
+    from barhinge.families import miura
     from barhinge.kinematics.path import rigid_fold
     from barhinge.pattern.fold import write_fold
-    from barhinge.patterns import miura
 
     root = tmp_path_factory.mktemp("malformed")
     cp = miura(2, 2, a=1.0, b=1.0, alpha=60.0, fold=5.0)

@@ -10,11 +10,11 @@ import barhinge as bh
 from barhinge.errors import ConfigError
 from barhinge.pattern.crease import CreasePattern
 from barhinge.scene import restraint_321
-from barhinge.solve.diagnose import diagnose, free_rigid_motions
+from barhinge.solver.diagnose import diagnose, free_rigid_motions
 
 
 def _miura_scene(supported, dofs="xyz", **kw):
-    cp = bh.patterns.miura(3, 3, fold=20.0)
+    cp = bh.families.miura(3, 3, fold=20.0)
     m = bh.BarHingeModel.from_pattern(cp, fold_stiffness=1.0)
     S = np.zeros((m.n_nodes, 3), bool)
     for v in supported:
@@ -42,7 +42,7 @@ def test_miura_with_two_supported_nodes_names_the_free_rotation():
     ],
 )
 def test_sheet_held_only_in_some_directions_names_each_free_motion(dofs_fixed, words):
-    cp = bh.patterns.miura(2, 2, fold=20.0)
+    cp = bh.families.miura(2, 2, fold=20.0)
     m = bh.BarHingeModel.from_pattern(cp, fold_stiffness=1.0)
     S = np.zeros((m.n_nodes, 3), bool)
     S[: cp.n_vertices, "xyz".index("z")] = True
@@ -66,7 +66,7 @@ def test_free_rigid_motions_of_points():
 
 
 def test_default_321_restraint_and_prescribed_displacements_hold_the_model():
-    cp = bh.patterns.miura(2, 2, fold=20.0)
+    cp = bh.families.miura(2, 2, fold=20.0)
     m = bh.BarHingeModel.from_pattern(cp, fold_stiffness=1.0)
     a = int(cp.crease_edges[12])
     acts = bh.Actuators(edges=[a], targets_deg=float(cp.fold_angles[a]) * 1.2)
@@ -106,7 +106,7 @@ def test_two_separate_sheets_are_named():
 @pytest.mark.parametrize("scale", [1e12, 1e-6])
 def test_restraint_and_solve_are_scale_free(scale):
     """a = b = 1e12 used to give "its vertices are collinear" (absolute tolerance)."""
-    cp = bh.patterns.miura(2, 2, a=scale, b=scale, fold=20.0)
+    cp = bh.families.miura(2, 2, a=scale, b=scale, fold=20.0)
     m = bh.BarHingeModel.from_pattern(cp, fold_stiffness=1.0)
     S = restraint_321(m)
     assert S.sum() == 6

@@ -70,15 +70,19 @@ def _paths(node: Any, prefix: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
 
 PATHS = _paths(BASE)
 # keys that exist in the format but not in BASE
-EXTRA = [
-    ("solve", "options", k)
-    for k in ("max_iter", "max_cutbacks", "reuse_factorization", "augmentation", "predictor")
-] + [("model", k) for k in ("stiffness_ratio", "fold_limits_deg", "bar_EA", "fold_k")] + [
-    ("actuators", "table_deg"),
-    ("pattern", "frame"),
-    ("supports", 0, "nodes"),
-    ("supports", 0, "edges"),
-]
+EXTRA = (
+    [
+        ("solve", "options", k)
+        for k in ("max_iter", "max_cutbacks", "reuse_factorization", "augmentation", "predictor")
+    ]
+    + [("model", k) for k in ("stiffness_ratio", "fold_limits_deg", "bar_EA", "fold_k")]
+    + [
+        ("actuators", "table_deg"),
+        ("pattern", "frame"),
+        ("supports", 0, "nodes"),
+        ("supports", 0, "edges"),
+    ]
+)
 
 mutation = st.tuples(
     st.sampled_from(PATHS + EXTRA),
@@ -157,9 +161,7 @@ array_values = st.one_of(
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     st.dictionaries(
-        st.sampled_from(
-            ["supports", "loads", "prescribed", "steps", "control", "options", "name"]
-        ),
+        st.sampled_from(["supports", "loads", "prescribed", "steps", "control", "options", "name"]),
         array_values,
         min_size=1,
         max_size=3,

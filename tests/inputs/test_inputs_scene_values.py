@@ -282,7 +282,7 @@ def test_scene_checks_steps_arrays_and_model():
 
 
 def test_from_pattern_checks_stiffness_arguments():
-    cp = bh.patterns.miura(1, 1)
+    cp = bh.families.miura(1, 1)
     for kw, key in [
         ({"fold_stiffness": float("nan")}, "fold_stiffness"),
         ({"fold_stiffness": -1.0}, "fold_stiffness"),
@@ -334,7 +334,7 @@ def test_non_finite_tangent_is_reported_as_singular_not_factorised():
     import scipy.sparse as sp
 
     from barhinge.linalg.backends import SingularMatrixError
-    from barhinge.solve.diagnose import check_finite_tangent
+    from barhinge.solver.diagnose import check_finite_tangent
 
     K = sp.csr_matrix(np.array([[1.0, np.inf], [np.inf, 1.0]]))
     with pytest.raises(SingularMatrixError, match="non-finite"):
@@ -343,7 +343,7 @@ def test_non_finite_tangent_is_reported_as_singular_not_factorised():
 
 
 def test_control_curves_check_their_numbers():
-    from barhinge.control import (
+    from barhinge.actuators.curves import (
         CircularArc,
         Parabola,
         SplineCurve,
@@ -361,7 +361,7 @@ def test_control_curves_check_their_numbers():
         (lambda: chain_on_curve(Parabola(1.0), [0.0, 1.0, float("inf")]), "section"),
         (lambda: synchronised([1, 2], 200.0), "angle_deg"),
         (lambda: synchronised([1.5], 20.0), "actuators.edges"),
-        (lambda: curve_schedule(bh.patterns.pleats(4), [1], Parabola(1.0), 2.5), "steps"),
+        (lambda: curve_schedule(bh.families.pleats(4), [1], Parabola(1.0), 2.5), "steps"),
     ]:
         with pytest.raises(ConfigError, match=key):
             make()

@@ -162,11 +162,11 @@ def test_sign_matches_pattern_state_on_hand_folded_strip() -> None:
 def test_sign_matches_folded_miura_state() -> None:
     """Fold hinges of a rigidly folded Miura (patterns helper's closed form) reproduce the
     pattern's state fold angles, with valleys positive."""
-    pytest.importorskip("barhinge.patterns.miura")
+    pytest.importorskip("barhinge.families.miura")
     import barhinge as bh
     from barhinge.model.model import BarHingeModel
 
-    cp = bh.patterns.miura(2, 2, fold=35.0)
+    cp = bh.families.miura(2, 2, fold=35.0)
     for scheme in ("N4B5", "N5B8"):
         m = BarHingeModel.from_pattern(cp, scheme=scheme)
         state = cp.state_fold_angles()

@@ -18,7 +18,7 @@ def test_dof_command_json_and_png(tmp_path):
     res = CliRunner().invoke(app, ["dof", "miura:nx=2,ny=2", "--json", "--png", str(png)])
     assert res.exit_code == 0, res.output
     data = json.loads(res.output)
-    direct = bh.dof(bh.patterns.miura(2, 2))
+    direct = bh.dof(bh.families.miura(2, 2))
     assert data["state"]["global_dof"] == direct.global_dof
     assert data["state"]["counted_dof"] == direct.counted_dof
     assert data["folded_state"]["global_dof"] == 1
@@ -40,7 +40,7 @@ def test_dof_command_table_and_bad_pattern():
 def test_draw_dof_returns_figure_with_actuators_marked():
     from barhinge.plot.dof import draw_dof
 
-    cp = bh.patterns.miura(2, 2)
+    cp = bh.families.miura(2, 2)
     rep = bh.dof(cp)
     fig = draw_dof(cp, rep, which="local")
     ax = fig.axes[0]

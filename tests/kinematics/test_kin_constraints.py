@@ -33,7 +33,7 @@ def _nullity(A, rel=1e-8):
 
 @pytest.mark.parametrize("triangulated", [False, True])
 def test_jacobian_matches_finite_differences_off_the_manifold(triangulated):
-    cp = bh.patterns.miura(2, 2, fold=35.0)
+    cp = bh.families.miura(2, 2, fold=35.0)
     rc = RigidConstraints.from_pattern(cp, triangulated=triangulated)
     rng = np.random.default_rng(1)
     x = rc.rho0 + 0.2 * rng.standard_normal(rc.n_var)  # not a rigid state: F != I
@@ -46,7 +46,7 @@ def test_jacobian_matches_finite_differences_off_the_manifold(triangulated):
 
 def test_jacobian_columns_are_crease_axes_at_a_closed_state():
     """At F = I the column of crease k is its current unit axis (Tachi 2009)."""
-    cp = bh.patterns.miura(2, 2, fold=50.0)
+    cp = bh.families.miura(2, 2, fold=50.0)
     rc = RigidConstraints.from_pattern(cp)
     J = rc.jacobian(rc.rho0).toarray()
     X = cp.vertices3d
@@ -67,11 +67,11 @@ def test_jacobian_columns_are_crease_axes_at_a_closed_state():
 @settings(max_examples=15, deadline=None)
 @given(theta=st.floats(1.0, 85.0), nx=st.integers(1, 3), ny=st.integers(1, 3))
 def test_coordinates_rebuilt_from_exact_angles_reproduce_the_folded_sheet(theta, nx, ny):
-    """Angles of the exact folded Miura (Schenk & Guest 2013 via bh.patterns) rebuild the
+    """Angles of the exact folded Miura (Schenk & Guest 2013 via bh.families) rebuild the
     same shape: all pairwise vertex distances agree, and the rebuilt state's measured fold
     angles equal the input."""
-    flat = bh.patterns.miura(nx, ny)
-    ref = bh.patterns.miura(nx, ny, fold=theta)
+    flat = bh.families.miura(nx, ny)
+    ref = bh.families.miura(nx, ny, fold=theta)
     rc = RigidConstraints.from_pattern(flat)
     rho = np.radians(ref.fold_angles[rc.crease_edge])
     assert rc.closure_error(rho).max() < 1e-12
@@ -85,7 +85,7 @@ def test_coordinates_rebuilt_from_exact_angles_reproduce_the_folded_sheet(theta,
 
 
 def test_nodal_jacobian_matches_finite_differences():
-    cp = bh.patterns.miura(1, 1, fold=30.0)
+    cp = bh.families.miura(1, 1, fold=30.0)
     nc = NodalConstraints.from_pattern(cp)
     X = cp.vertices3d + 0.05 * np.random.default_rng(2).standard_normal(cp.vertices3d.shape)
     _, J = nc.evaluate(X)
@@ -99,7 +99,7 @@ def test_nodal_jacobian_matches_finite_differences():
 def test_nodal_and_angle_formulations_have_the_same_dof(n, triangulated, theta):
     """DOF(angles) = nullity(J_angle) and DOF(nodal) = nullity(J_nodal) - 6 agree, both at
     the flat state (first order) and at a folded state."""
-    cp = bh.patterns.miura(n, n, fold=theta)
+    cp = bh.families.miura(n, n, fold=theta)
     rc = RigidConstraints.from_pattern(cp, triangulated=triangulated)
     nc = NodalConstraints.from_pattern(cp, triangulated=triangulated)
     r, J = nc.evaluate(cp.vertices3d)

@@ -37,9 +37,9 @@ def _nodal_dof(cp, X, triangulated=False) -> int:
 
 
 def _family(name, **kw):
-    if name not in bh.patterns.FAMILIES:
+    if name not in bh.families.FAMILIES:
         pytest.skip(f"pattern family {name} not available")
-    return bh.patterns.FAMILIES[name](**kw)
+    return bh.families.FAMILIES[name](**kw)
 
 
 def test_miura_rigid_quads_one_dof_from_redundant_constraints():
@@ -47,7 +47,7 @@ def test_miura_rigid_quads_one_dof_from_redundant_constraints():
     sheet folds with 1 DOF because the vertex conditions are redundant (Tachi 2009, 2010):
     redundant = 1 - count. The flat state is a bifurcation point with a larger first-order
     DOF."""
-    cp = bh.patterns.miura(3, 3)
+    cp = bh.families.miura(3, 3)
     rep = bh.dof(cp)
     assert rep.counted_dof == _tachi_count(cp) == 60 - 3 * 25  # 60 creases, 25 int. vertices
     assert rep.flat and rep.folded is not None
@@ -58,12 +58,12 @@ def test_miura_rigid_quads_one_dof_from_redundant_constraints():
     assert np.all(f.local[f.local >= 0] == 1) and np.all(f.region[f.region >= 0] == 1)
     assert len(f.actuators) == 1
     # at an exact folded state from the closed form: same numbers
-    g = bh.dof(bh.patterns.miura(3, 3, fold=50.0))
+    g = bh.dof(bh.families.miura(3, 3, fold=50.0))
     assert not g.flat and g.global_dof == 1 and g.redundant == 16
 
 
 def test_miura_triangulated_dof_equals_boundary_edges_minus_three():
-    cp = bh.patterns.miura(3, 3)
+    cp = bh.families.miura(3, 3)
     rep = bh.dof(cp, triangulated=True)
     f = rep.folded
     n_boundary = len(cp.boundary_edges)
@@ -116,8 +116,8 @@ def test_family_dof_rank_agrees_with_nodal_formulation(name, kw, triangulated):
 
 
 def test_dof_of_a_given_state_by_angles_and_coordinates():
-    cp = bh.patterns.miura(2, 2)
-    ref = bh.patterns.miura(2, 2, fold=35.0)
+    cp = bh.families.miura(2, 2)
+    ref = bh.families.miura(2, 2, fold=35.0)
     by_angles = bh.dof(cp, state=ref.fold_angles)
     by_coords = bh.dof(cp, state=ref.vertices3d)
     assert by_angles.global_dof == by_coords.global_dof == 1
@@ -175,7 +175,7 @@ def test_suggested_actuators_drive_a_rigid_path():
 
 
 def _holed_miura(fold=None, drop=(14,)):
-    cp = bh.patterns.miura(4, 4) if fold is None else bh.patterns.miura(4, 4, fold=fold)
+    cp = bh.families.miura(4, 4) if fold is None else bh.families.miura(4, 4, fold=fold)
     faces = [f for i, f in enumerate(cp.faces) if i not in drop]  # remove inner panels
     return bh.CreasePattern(
         cp.vertices, cp.edges, cp.assignment, cp.fold_angles, faces=faces, validate=False
@@ -212,7 +212,7 @@ def test_hole_chain_jacobian_matches_finite_differences():
     hl = hole_loops(rc)
     assert hl.n_holes == 2 and hl.unclosed == 0
     # a rigid folded state from the closed form closes every chain
-    ref = bh.patterns.miura(4, 4, fold=50.0)
+    ref = bh.families.miura(4, 4, fold=50.0)
     rho = np.zeros(rc.n_var)
     vs = rc.var_source_edge
     rho[vs >= 0] = np.radians(ref.fold_angles[vs[vs >= 0]])
@@ -285,7 +285,7 @@ def test_progress_reports_every_stage_in_order():
     """``bh.dof(progress=...)`` is called before each stage and once at the end (the CLI's
     progress bar); a flat pattern with a folded state nearby has 8 stages."""
     calls = []
-    rep = bh.dof(bh.patterns.miura(3, 3), progress=lambda *a: calls.append(a))
+    rep = bh.dof(bh.families.miura(3, 3), progress=lambda *a: calls.append(a))
     assert rep.folded is not None
     stages = [c[0] for c in calls]
     assert stages[0] == "loop-closure constraints" and stages[-1] == "done"
@@ -301,7 +301,7 @@ def test_wide_flat_null_space_gives_the_same_report_without_flat_actuators(monke
     import importlib
 
     dof_mod = importlib.import_module("barhinge.kinematics.dof")
-    cp = bh.patterns.FAMILIES["yoshimura"](nx=16, ny=16)
+    cp = bh.families.FAMILIES["yoshimura"](nx=16, ny=16)
     full = bh.dof(cp)
     monkeypatch.setattr(dof_mod, "FLAT_BASIS_LIMIT", 50)
     wide = bh.dof(cp)

@@ -17,7 +17,7 @@ from barhinge.verify import degree4_pattern
 def test_multiplier_hessian_matches_finite_differences(n):
     """Hessian of lam . r against central differences of J^T lam, at a random (unclosed)
     state, so the general formula (F != I) is checked, not only its closed-loop limit."""
-    rc = RigidConstraints.from_pattern(bh.patterns.miura(n, n))
+    rc = RigidConstraints.from_pattern(bh.families.miura(n, n))
     rng = np.random.default_rng(1)
     rho = 0.5 * rng.normal(size=rc.n_var)
     lam = rng.normal(size=rc.n_eq)
@@ -51,8 +51,8 @@ def test_flat_start_takes_the_assigned_mode_of_a_degree4_vertex():
 
 
 def test_actuator_against_the_assignment_mirrors_the_branch_and_says_so():
-    cp = bh.patterns.miura(3, 3).replaced(fold_angles=np.zeros(bh.patterns.miura(3, 3).n_edges))
-    z = int(bh.patterns.miura_layout(3, 3).interior_zigzag_edges[0])
+    cp = bh.families.miura(3, 3).replaced(fold_angles=np.zeros(bh.families.miura(3, 3).n_edges))
+    z = int(bh.families.miura_layout(3, 3).interior_zigzag_edges[0])
     sign = 1.0 if cp.assignment[z] == "M" else -1.0  # against its assignment
     path = bh.rigid_fold(cp, [z], targets_deg=[sign * 50.0], steps=4)
     assert path.meta["mirrored"]
@@ -65,8 +65,8 @@ def test_actuator_against_the_assignment_mirrors_the_branch_and_says_so():
 def test_underactuated_miura_flat_start_matches_the_one_dof_path():
     """Miura 3x3 has 1 DOF once folded; from the flat state (10 infinitesimal DOF) one
     actuator must give the same path as the 1-DOF kinematics, whatever the weights."""
-    cp = bh.patterns.miura(3, 3)
-    z = int(bh.patterns.miura_layout(3, 3).interior_zigzag_edges[0])
+    cp = bh.families.miura(3, 3)
+    z = int(bh.families.miura_layout(3, 3).interior_zigzag_edges[0])
     t = cp.fold_angles[z] / 2
     ref = bh.rigid_fold(cp, [z], [t], steps=5)
     w = np.random.default_rng(2).uniform(0.5, 2.0, cp.n_edges)
@@ -79,7 +79,7 @@ def test_energy_minimum_is_stationary_on_the_manifold():
     """Under-actuated Yoshimura: at the returned state the energy gradient has no component
     along the free motions (null space of the Jacobian with the actuators held), checked
     against an independent dense SVD."""
-    cp = bh.patterns.yoshimura(4, 3)
+    cp = bh.families.yoshimura(4, 3)
     rep = bh.dof(cp)
     a = [int(rep.mechanism.actuators[0])]
     path = bh.rigid_fold(cp, a, targets_deg=[0.5 * cp.fold_angles[a[0]]], steps=4)
@@ -102,7 +102,7 @@ def test_energy_minimum_is_stationary_on_the_manifold():
 
 
 @pytest.mark.parametrize(
-    "cp", [bh.patterns.resch(3, 3), bh.patterns.waterbomb(3, 3)], ids=["resch", "waterbomb"]
+    "cp", [bh.families.resch(3, 3), bh.families.waterbomb(3, 3)], ids=["resch", "waterbomb"]
 )
 def test_resch_and_waterbomb_fold_from_flat_or_fail_by_name(cp):
     rep = bh.dof(cp)
@@ -123,7 +123,7 @@ def test_underactuated_yoshimura_has_several_strict_energy_minima():
     manifold (projected gradient ~0 and positive reduced Hessian of the Lagrangian, both by
     dense linear algebra independent of the solver), with energies a few percent apart and
     over a dozen creases folding against their assignment in both (docs/solver.md)."""
-    cp = bh.patterns.yoshimura(4, 3)
+    cp = bh.families.yoshimura(4, 3)
     a = [int(bh.dof(cp).mechanism.actuators[0])]
     rc = RigidConstraints.from_pattern(cp)
     E = rc.pattern.edges[rc.crease_edge]

@@ -17,8 +17,8 @@ def miura30_path():
     """30 x 30 cells (61 x 61 vertices, 7080 creases), driven by one zig-zag crease in the
     middle from flat to -150 deg (its mountain side) in 10 steps."""
     nx = ny = 30
-    cp = bh.patterns.miura(nx, ny, a=1.0, b=1.3, alpha=55.0)
-    lay = bh.patterns.miura_layout(nx, ny)
+    cp = bh.families.miura(nx, ny, a=1.0, b=1.3, alpha=55.0)
+    lay = bh.families.miura_layout(nx, ny)
     zz = lay.interior_zigzag_edges
     e = int(zz[len(zz) // 2])
     sign = 1.0 if cp.assignment[e] == "V" else -1.0
@@ -60,7 +60,7 @@ def test_miura_path_follows_schenk_guest(miura30_path):
     for s in range(1, path.n_states):
         rho = path.fold_angles_deg[s]
         th = np.radians(sign * rho[e]) / 2
-        ref = bh.patterns.miura_fold_angles(lay, 55.0, np.degrees(th))
+        ref = bh.families.miura_fold_angles(lay, 55.0, np.degrees(th))
         np.testing.assert_allclose(rho, ref, rtol=0, atol=1e-9)
         rs = np.radians(np.abs(rho[lay.interior_straight_edges]))
         np.testing.assert_allclose(rs, 2 * np.arctan(np.cos(g) * np.tan(th)), rtol=0, atol=1e-9)
@@ -84,8 +84,8 @@ def test_miura_path_follows_schenk_guest(miura30_path):
 def test_path_with_actuators_schedule_and_folded_start():
     """A table schedule from a folded start state; starts from the pattern's own geometry and
     returns the schedule's angles exactly."""
-    cp = bh.patterns.miura(3, 2, fold=20.0)
-    lay = bh.patterns.miura_layout(3, 2)
+    cp = bh.families.miura(3, 2, fold=20.0)
+    lay = bh.families.miura_layout(3, 2)
     e = int(lay.interior_straight_edges[3])
     start = cp.fold_angles[e]
     table = np.array([[start * 1.5], [start * 2.0], [start * 1.2]])
@@ -101,7 +101,7 @@ def test_path_with_actuators_schedule_and_folded_start():
 
 
 def test_actuator_that_is_not_a_crease_is_rejected():
-    cp = bh.patterns.miura(2, 2)
+    cp = bh.families.miura(2, 2)
     b = int(cp.boundary_edges[0])
     with pytest.raises(ConfigError, match=f"actuator edge {b} .* not a foldable"):
         bh.rigid_fold(cp, [b], [30.0], steps=2)
@@ -112,8 +112,8 @@ def test_under_determined_actuators_are_resolved_by_the_fold_energy():
     motions are resolved by minimising the spring energy; as the diagonals stiffen the
     result must approach the rigid-panel path (an independent solve with 1 DOF, no energy)
     with error proportional to 1 / diagonal stiffness (log-log slope -1)."""
-    cp = bh.patterns.miura(2, 2)
-    act = [int(bh.patterns.miura_layout(2, 2).interior_zigzag_edges[0])]
+    cp = bh.families.miura(2, 2)
+    act = [int(bh.families.miura_layout(2, 2).interior_zigzag_edges[0])]
     ref = bh.rigid_fold(cp, act, [-40.0], steps=4).fold_angles_deg[-1]
     ks = np.array([1e3, 1e4, 1e5])
     err = []
@@ -127,8 +127,8 @@ def test_under_determined_actuators_are_resolved_by_the_fold_energy():
 
 
 def _incompatible_miura():
-    cp = bh.patterns.miura(2, 2, fold=30.0)
-    lay = bh.patterns.miura_layout(2, 2)
+    cp = bh.families.miura(2, 2, fold=30.0)
+    lay = bh.families.miura_layout(2, 2)
     z, s = int(lay.interior_zigzag_edges[0]), int(lay.interior_straight_edges[0])
     return cp, [z, s], [cp.fold_angles[z] * 1.5, cp.fold_angles[s] * 0.5]
 
@@ -170,8 +170,8 @@ def test_incompatible_targets_are_met_in_least_squares():
 
 def test_compatible_over_determined_actuators_are_accepted():
     """Two creases of the same family driven alike stay compatible."""
-    cp = bh.patterns.miura(2, 2, fold=30.0)
-    zz = bh.patterns.miura_layout(2, 2).interior_zigzag_edges
+    cp = bh.families.miura(2, 2, fold=30.0)
+    zz = bh.families.miura_layout(2, 2).interior_zigzag_edges
     z = [int(k) for k in zz if cp.fold_angles[k] > 0][:2]
     path = bh.rigid_fold(cp, z, [100.0, 100.0], steps=4)
     assert path.converged
@@ -179,8 +179,8 @@ def test_compatible_over_determined_actuators_are_accepted():
 
 
 def test_locking_threshold_stops_the_path():
-    cp = bh.patterns.miura(2, 2)
-    e = int(bh.patterns.miura_layout(2, 2).interior_zigzag_edges[0])
+    cp = bh.families.miura(2, 2)
+    e = int(bh.families.miura_layout(2, 2).interior_zigzag_edges[0])
     sign = 1.0 if cp.assignment[e] == "V" else -1.0
     from barhinge.kinematics.path import RigidOptions
 
@@ -195,9 +195,9 @@ def test_corrector_converges_quadratically():
     forcing term eta_k ~ |r_k| (Dembo, Eisenstat & Steihaug 1982): r_{k+1} <= C r_k^2."""
     from barhinge.kinematics.path import RigidOptions, RigidSolver
 
-    cp = bh.patterns.miura(4, 4, fold=40.0)
+    cp = bh.families.miura(4, 4, fold=40.0)
     rc = RigidConstraints.from_pattern(cp)
-    e = int(bh.patterns.miura_layout(4, 4).interior_zigzag_edges[3])
+    e = int(bh.families.miura_layout(4, 4).interior_zigzag_edges[3])
     act = rc.var_of_source_edge[[e]]
     solver = RigidSolver(rc, act, RigidOptions(tol=1e-15, max_iter=10))
     x = rc.rho0 + 3e-3 * np.random.default_rng(0).standard_normal(rc.n_var)
@@ -218,8 +218,8 @@ def test_large_sheet_backend_gives_the_same_path(monkeypatch):
     fold angles and coordinates agree to round-off of the corrector."""
     from barhinge.kinematics import path as rigid_path
 
-    cp = bh.patterns.miura(4, 4, fold=20.0)
-    lay = bh.patterns.miura_layout(4, 4)
+    cp = bh.families.miura(4, 4, fold=20.0)
+    lay = bh.families.miura_layout(4, 4)
     e = int(lay.interior_straight_edges[2])
     act = bh.Actuators(edges=[e], targets_deg=[2.5 * cp.fold_angles[e]])
     ref = bh.rigid_fold(cp, act, steps=5)

@@ -15,7 +15,7 @@ def test_sparse_rank_agrees_with_dense_svd():
     """The sparse shift-invert method used above 600 creases gives the dense SVD's rank and
     null space (flat Miura: first-order DOF 4n - 2 for n x n cells; folded: 1)."""
     n = 4
-    cp = bh.patterns.miura(n, n)
+    cp = bh.families.miura(n, n)
     rc = RigidConstraints.from_pattern(cp)
     for rho in (rc.rho0, folded_sample(rc)):
         J = rc.jacobian(rho)
@@ -35,7 +35,7 @@ def test_wide_null_space_without_basis_agrees_with_dense_svd_and_full_path():
     the nullity the sparse method skips the null vectors; its rank and its singular value
     above the cut (inertia bisection) agree with the dense SVD (independent) and with the
     full sparse path, and the gap ratio is the same certain cut."""
-    cp = bh.patterns.FAMILIES["yoshimura"](nx=14, ny=14)
+    cp = bh.families.FAMILIES["yoshimura"](nx=14, ny=14)
     rc = RigidConstraints.from_pattern(cp)
     J = rc.jacobian(rc.rho0)
     dense = null_space(J, dense_limit=10**6)

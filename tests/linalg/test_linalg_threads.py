@@ -91,6 +91,6 @@ def test_public_calls_run_under_the_policy(monkeypatch):
             super().__init__(*a, **k)
 
     monkeypatch.setattr(dofmod, "RigidConstraints", Spy)
-    bh.dof(bh.patterns.miura(2, 2))
+    bh.dof(bh.families.miura(2, 2))
     assert seen and all(set(s.values()) == {1} for s in seen)
     assert bh.dof.__name__ == "dof" and "Parameters" in (bh.dof.__doc__ or "")

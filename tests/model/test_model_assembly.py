@@ -32,7 +32,7 @@ def single_fold(fold_deg: float = 0.0) -> CreasePattern:
 
 def models():
     out = [BarHingeModel.from_pattern(single_fold(40.0), "N4B5", MAT)]
-    cp = bh.patterns.miura(2, 1, fold=35.0)
+    cp = bh.families.miura(2, 1, fold=35.0)
     for s in ("N4B5", "N5B8"):
         out.append(BarHingeModel.from_pattern(cp, s, MAT))
     out.append(
@@ -140,7 +140,7 @@ def test_zero_eigenvalues_degree4_vertex(scheme: str) -> None:
     * any state with fold stiffness > 0: exactly the 6 rigid-body modes.
     """
     for fold, expect in ((30.0, 7), (None, 8)):
-        cp = bh.patterns.miura(1, 1, fold=fold)
+        cp = bh.families.miura(1, 1, fold=fold)
         nz, gap = n_zero_eigenvalues(
             BarHingeModel.from_pattern(cp, scheme, MAT, fold_stiffness=0.0)
         )

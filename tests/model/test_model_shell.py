@@ -87,7 +87,7 @@ def test_folded_shell_has_exactly_the_rigid_body_modes():
     coupling are consistent); with crease springs of zero stiffness it gains the cell's
     one-DOF folding mechanism of rigid origami... and the facets' own bending modes stay
     stiff (7 = 6 + 1)."""
-    cp = bh.patterns.miura(1, 1, fold=60.0)
+    cp = bh.families.miura(1, 1, fold=60.0)
     assert _null_dim(shell_model(cp, MAT, 1).K) == 6
     assert _null_dim(shell_model(cp, MAT, 1, crease_stiffness=MAT.bending_rigidity).K) == 6
     assert _null_dim(shell_model(cp, MAT, 1, crease_stiffness=0.0).K) == 7

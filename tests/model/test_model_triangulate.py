@@ -52,7 +52,7 @@ def test_n4b5_splits_along_the_shorter_diagonal() -> None:
 
 def test_miura_counts_and_bookkeeping() -> None:
     nx, ny = 3, 2
-    cp = bh.patterns.miura(nx, ny, fold=30.0)
+    cp = bh.families.miura(nx, ny, fold=30.0)
     nf = cp.n_faces
     n_crease = len(cp.crease_edges)
     for scheme, extra_nodes, bars_per_face, bend_per_face in (("N4B5", 0, 1, 1), ("N5B8", 1, 4, 4)):
@@ -95,10 +95,12 @@ def test_nonplanar_quad_n5b8_rest_angles_take_the_state() -> None:
 
 
 def test_stiffness_defaults_overrides_and_ratio() -> None:
-    cp = bh.patterns.miura(2, 2)
+    cp = bh.families.miura(2, 2)
     mat = Material(E=2e9, nu=0.3, t=1e-3)
     D = mat.bending_rigidity
-    m = BarHingeModel.from_pattern(cp, "N5B8", mat, crease_length_scale=0.05)
+    m = BarHingeModel.from_pattern(
+        cp, "N5B8", mat, crease_length_scale=0.05, bend_calibration="filipov"
+    )
     fold = m.hinge_kind == "fold"
     L = np.linalg.norm(m.X0[m.hinges[fold, 1]] - m.X0[m.hinges[fold, 0]], axis=1)
     # Filipov et al. 2017: k_F = L_F * D / L*
@@ -113,7 +115,9 @@ def test_stiffness_defaults_overrides_and_ratio() -> None:
     m3 = BarHingeModel.from_pattern(cp, "N5B8", mat, bar_EA=5.0, bend_k=2.0, fold_k=0.1)
     assert (m3.bar_EA == 5.0).all() and (m3.hinge_k[bend] == 2.0).all()
     assert (m3.hinge_k[fold] == 0.1).all()
-    m4 = BarHingeModel.from_pattern(cp, "N5B8", mat, crease_length_scale=0.05, stiffness_ratio=10.0)
+    m4 = BarHingeModel.from_pattern(
+        cp, "N5B8", mat, crease_length_scale=0.05, stiffness_ratio=10.0, bend_calibration="filipov"
+    )
     assert np.allclose(m4.bar_EA, 10 * m.bar_EA) and np.allclose(
         m4.hinge_k[bend], 10 * m.hinge_k[bend]
     )
@@ -138,7 +142,7 @@ def test_stiffness_defaults_overrides_and_ratio() -> None:
 )
 def test_bad_options_raise_config_error(kwargs: dict) -> None:
     with pytest.raises(ConfigError):
-        BarHingeModel.from_pattern(bh.patterns.miura(1, 1), **kwargs)
+        BarHingeModel.from_pattern(bh.families.miura(1, 1), **kwargs)
 
 
 def test_bad_material_and_coordinates() -> None:
@@ -146,7 +150,7 @@ def test_bad_material_and_coordinates() -> None:
         Material(E=-1.0)
     with pytest.raises(ConfigError):
         Material(nu=0.6)
-    m = BarHingeModel.from_pattern(bh.patterns.miura(1, 1))
+    m = BarHingeModel.from_pattern(bh.families.miura(1, 1))
     with pytest.raises(ConfigError):
         m.evaluate(np.zeros((3, 3)))
 

@@ -126,8 +126,8 @@ def test_model_state_arrays_against_direct_formulas():
     angles on crease bars equal the model's hinge angles."""
     bh = pytest.importorskip("barhinge")
     pytest.importorskip("barhinge.model.model")
-    pytest.importorskip("barhinge.patterns")
-    cp = bh.patterns.miura(2, 2, fold=40.0)
+    pytest.importorskip("barhinge.families")
+    cp = bh.families.miura(2, 2, fold=40.0)
     model = bh.BarHingeModel.from_pattern(cp, material=bh.Material(E=1e3, nu=0.3, t=0.01))
     rng = np.random.default_rng(1)
     X = model.X0 + 1e-3 * rng.normal(size=model.X0.shape)
@@ -150,7 +150,7 @@ def test_write_results_of_a_bar_hinge_path(tmp_path):
     the summary; the energy densities integrate to the model's energy split."""
     bh = pytest.importorskip("barhinge")
     pytest.importorskip("barhinge.model.model")
-    patterns = pytest.importorskip("barhinge.patterns")
+    patterns = pytest.importorskip("barhinge.families")
     cp = patterns.miura(2, 2, fold=30.0)
     model = bh.BarHingeModel.from_pattern(cp, material=bh.Material(E=1e3, nu=0.3, t=0.01))
     rng = np.random.default_rng(3)
@@ -194,10 +194,11 @@ def test_vtu_force_fields_match_the_strains_and_fold_angles(tmp_path):
     import meshio
 
     import barhinge as bh
+    from barhinge.families import miura_line_creases
     from barhinge.output.fields import write_state_vtu
-    from barhinge.scene import Scene, miura_line_creases
+    from barhinge.scene import Scene
 
-    cp = bh.patterns.miura(2, 2, fold=20.0)
+    cp = bh.families.miura(2, 2, fold=20.0)
     model = bh.BarHingeModel.from_pattern(cp, material=bh.Material(E=1e3, nu=0.3, t=0.01))
     edges = miura_line_creases(cp)
     acts = bh.Actuators(edges=edges, targets_deg=np.asarray(cp.fold_angles)[edges] * 1.5)
@@ -227,3 +228,28 @@ def test_vtu_force_fields_match_the_strains_and_fold_angles(tmp_path):
     R = m.point_data["reaction"]
     assert np.all(R[~scene.fixed.any(axis=1)] == 0.0)
     assert np.linalg.norm(R.sum(axis=0)) < 1e-8
+
+
+def test_membrane_N_field_of_a_homogeneous_stretch():
+    """A flat sheet stretched by a uniform strain e_xx: every panel triangle carries the
+    plane-stress resultant t E / (1 - nu^2) (E_xx, nu E_xx, 0) of the Green strain
+    E_xx = e + e^2 / 2 (Timoshenko & Goodier: plane stress), in global axes."""
+    import barhinge as bh
+    from barhinge.output.fields import state_mesh
+
+    cp = bh.families.miura(nx=2, ny=2, fold=0.0)
+    mat = bh.Material(E=1e6, nu=0.3, t=0.01)
+    model = bh.BarHingeModel.from_pattern(cp, "N5B8", mat)
+    e = 1e-3
+    X = np.asarray(model.X0, float).copy()
+    X[:, 0] *= 1.0 + e
+    data = state_data(X, model=model)
+    N = data.triangle_data["membrane_N"].reshape(-1, 3, 3)
+    Exx = e + e * e / 2
+    c = mat.t * mat.E / (1 - mat.nu**2)
+    np.testing.assert_allclose(N[:, 0, 0], c * Exx, rtol=1e-9)
+    np.testing.assert_allclose(N[:, 1, 1], c * mat.nu * Exx, rtol=1e-9)
+    np.testing.assert_allclose(N[:, 0, 1], 0.0, atol=1e-9 * c * Exx)
+    assert np.isnan(data.line_data["membrane_N"]).all()
+    mesh = state_mesh(data=data)
+    assert any("membrane_N" in k for k in mesh.cell_data)

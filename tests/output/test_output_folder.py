@@ -40,7 +40,7 @@ control = "fold_angle"
 
 def miura_scene(folder: Path, n: int = 2, steps: int = 4, target: float = 40.0) -> Path:
     """A small Miura scene TOML (n x n, its first crease (a valley) actuated)."""
-    edge = int(bh.patterns.miura(n, n, fold=5.0).crease_edges[0])
+    edge = int(bh.families.miura(n, n, fold=5.0).crease_edges[0])
     f = folder / f"miura{n}_{steps}.toml"
     f.write_text(SCENE.format(name=f"miura-{n}x{n}", n=n, steps=steps, target=target, edge=edge))
     return f
@@ -165,7 +165,7 @@ def test_fold_refuses_a_foreign_folder_before_solving(tmp_path, monkeypatch):
     out = tmp_path / "mine"
     out.mkdir()
     (out / "notes.txt").write_text("keep me")
-    from barhinge.solve import newton
+    from barhinge.solver import newton
 
     called = []
     with monkeypatch.context() as m:
@@ -204,7 +204,7 @@ def test_solve_interrupted_carries_the_converged_steps(tmp_path):
 
 
 def test_fold_interrupted_writes_partial_results_and_exits_130(tmp_path, monkeypatch):
-    from barhinge.solve import newton
+    from barhinge.solver import newton
 
     real = newton.solve
 

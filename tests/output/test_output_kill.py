@@ -119,7 +119,7 @@ def test_sigkill_never_leaves_a_mixed_folder(tmp_path):
 
 SIGINT_AT_STEP = """
 import os, signal, sys
-from barhinge.solve import newton
+from barhinge.solver import newton
 
 real = newton.solve
 

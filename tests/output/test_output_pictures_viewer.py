@@ -13,14 +13,15 @@ import pytest
 
 import barhinge as bh
 from barhinge.errors import ConfigError
+from barhinge.families import miura_line_creases
 from barhinge.output.run import picture_level, write_run
 from barhinge.output.summary import summary_rows
-from barhinge.scene import Scene, miura_line_creases
+from barhinge.scene import Scene
 
 
 @pytest.fixture(scope="module")
 def solved():
-    cp = bh.patterns.miura(2, 2, fold=20.0)
+    cp = bh.families.miura(2, 2, fold=20.0)
     model = bh.BarHingeModel.from_pattern(cp, material=bh.Material(E=1e3, nu=0.3, t=0.01))
     edges = miura_line_creases(cp)
     acts = bh.Actuators(edges=edges, targets_deg=np.asarray(cp.fold_angles)[edges] * 1.5)
@@ -138,7 +139,7 @@ def test_unloaded_scene_has_no_buckling_record(solved, tmp_path):
 
 def test_summary_reports_factorisations_per_step(solved, tmp_path):
     """The step-control record of the solver (counted independently in
-    tests/solve/test_newton_stats.py) reaches summary.json and the printed table."""
+    tests/solver/test_newton_stats.py) reaches summary.json and the printed table."""
     scene, path = solved
     run = write_run(path, scene, tmp_path / "out", pictures="none", viewer=False)
     nw = run.summary["newton"]

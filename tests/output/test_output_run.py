@@ -13,7 +13,7 @@ from barhinge.output.run import write_results
 from barhinge.output.summary import summary_rows
 
 pytest.importorskip("barhinge.model.model")
-patterns = pytest.importorskip("barhinge.patterns")
+patterns = pytest.importorskip("barhinge.families")
 
 
 def test_write_results_writes_files_pictures_and_rows(tmp_path, monkeypatch):

@@ -43,7 +43,7 @@ def test_b_edge_between_two_faces_is_a_crease_with_a_warning():
 
 
 def test_info_calls_a_sheet_in_the_xz_plane_flat(tmp_path):
-    cp = bh.patterns.miura(2, 2)
+    cp = bh.families.miura(2, 2)
     V = cp.vertices
     V3 = np.column_stack([V[:, 0], np.zeros(len(V)), V[:, 1]])  # the xz plane
     tilted = cp.replaced(vertices=V3, validate=False)

@@ -20,7 +20,7 @@ def _area(cp) -> float:
 
 @pytest.mark.parametrize(
     "cp",
-    [bh.patterns.miura(2, 2, fold=50.0), bh.patterns.yoshimura(3, 2, fold=20.0)],
+    [bh.families.miura(2, 2, fold=50.0), bh.families.yoshimura(3, 2, fold=20.0)],
     ids=["quads", "triangles"],
 )
 @pytest.mark.parametrize("m", [2, 3])

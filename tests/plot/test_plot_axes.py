@@ -45,7 +45,7 @@ def test_supports_and_loads_are_drawn(tmp_path):
     """Black dots at supports and arrows at loads: the picture changes at those nodes only."""
     from PIL import Image
 
-    from barhinge.patterns import miura
+    from barhinge.families import miura
     from barhinge.plot import render
 
     if not render.can_render_offscreen():

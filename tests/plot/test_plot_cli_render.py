@@ -13,7 +13,7 @@ from barhinge import FoldPath
 from barhinge.cli import app
 from barhinge.output.run import write_results
 
-patterns = pytest.importorskip("barhinge.patterns")
+patterns = pytest.importorskip("barhinge.families")
 pytest.importorskip("barhinge.pattern.fold")
 
 

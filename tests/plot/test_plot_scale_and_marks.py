@@ -32,7 +32,7 @@ def test_support_and_load_marks_are_scaled_to_the_state():
 def test_matplotlib_fallback_draws_supports_and_loads(tmp_path):
     from PIL import Image
 
-    cp = bh.patterns.miura(nx=2, ny=2, fold=30.0)
+    cp = bh.families.miura(nx=2, ny=2, fold=30.0)
     X = cp.vertices3d
     fixed = np.zeros((len(X), 3), bool)
     fixed[0] = True

@@ -1,4 +1,4 @@
-"""Control surfaces (barhinge.control.ControlSurface, surface_actuators)."""
+"""Control surfaces (barhinge.actuators.curves.ControlSurface, surface_actuators)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import barhinge as bh
-from barhinge.control import (
+from barhinge.actuators.curves import (
     ControlSurface,
     Parabola,
     curve_actuators,
@@ -26,7 +26,7 @@ def test_surface_sections_are_its_principal_parabolas() -> None:
 
 
 def test_surface_actuators_drive_both_sections_with_their_curves() -> None:
-    cp = bh.patterns.miura(nx=3, ny=3)
+    cp = bh.families.miura(nx=3, ny=3)
     surf = ControlSurface(0.15, -0.1)
     acts = surface_actuators(cp, surf)
     ex = section_crossings(cp)[0]
@@ -43,7 +43,7 @@ def test_surface_actuators_drive_both_sections_with_their_curves() -> None:
 def test_shallow_parabola_rotation_is_curvature_times_spacing() -> None:
     """Small curvature: the turning angle at an actuator is kappa times the mean of the two
     gaps (chord geometry; the circle gives 2 arcsin(kappa d / 2) = kappa d + O(kappa^3))."""
-    cp = bh.patterns.miura(nx=3, ny=3)
+    cp = bh.families.miura(nx=3, ny=3)
     k = 1e-4
     acts = surface_actuators(cp, ControlSurface(k, 0.0))
     ex, x, ends = section_crossings(cp)

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from barhinge.control import (
+from barhinge.actuators.curves import (
     CircularArc,
     Parabola,
     SplineCurve,
@@ -200,7 +200,7 @@ def test_height_mapping_and_synchronised() -> None:
 
 def test_figure_is_written(tmp_path) -> None:
     pytest.importorskip("matplotlib")
-    from barhinge.plot.control import plot_control_curve
+    from barhinge.plot.curves import plot_control_curve
 
     curve = CircularArc(0.3)
     chain = chain_on_curve(curve, np.arange(7.0) - 3.0)

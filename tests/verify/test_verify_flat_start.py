@@ -39,7 +39,7 @@ def test_references_are_schenk_guest_at_theta_30():
 
 
 def test_gap_is_a_few_hundredths_of_a_degree(rows):
-    """The rigid-limit gap at ratio 1e5 is the one the tolerances quote (~0.04 deg)."""
+    """The rigid-limit gap at ratio 1e6 is the one the tolerances quote (~0.02 deg)."""
     for q in ("rho_zigzag_deg", "rho_straight_deg"):
         gap = abs(rows[q].computed - rows[q].reference)
         assert 0.005 < gap < 0.06, (q, gap)

@@ -1,0 +1,398 @@
+"""Model no more than a scene needs: the lightest model that meets a requested accuracy
+(``barhinge fold --accuracy 2%``, :func:`choose_model`).
+
+Candidates, lightest first: the rigid form (rigid kinematics; no elastic deformation), N4B5,
+N5B8, and N5B8 with every panel cut into ``m x m`` cells (``m = 2, 4, 8, 16``;
+:func:`barhinge.pattern.subdivide.subdivided`) whose bend and flat-line hinges follow the
+plate-consistent rule of :mod:`barhinge.model.plate_hinges`. Creases keep the scene model's
+fold stiffness per unit length in every candidate.
+
+Error estimates (all computed here, from the linear response at the scene's reference state
+under its loads and supports):
+
+* outputs ``"stiffness"`` (total load squared over the compliance ``f . u``) and
+  ``"displacement"`` (largest nodal displacement): the subdivided levels are extrapolated to
+  ``m -> infinity`` (Richardson, observed rate of the three finest levels computed); a
+  candidate's estimated error is its distance to that reference plus the extrapolation's own
+  correction (the uncertainty of the reference). Levels are refined until the finest meets
+  the target (or ``max_m``).
+* the scene's vertex loads are read as a distributed load (:func:`_spread_loads`), so that
+  every level carries the same load (point loads on a folded sheet have no converged
+  compliance: the membrane's displacement under a point force is log-singular).
+* output ``"form"`` (node positions, relative to the size of the sheet): an elastic
+  candidate's error is the change of its largest displacement against the reference over the
+  bounding-box diagonal; the rigid form's error is the whole elastic displacement over that
+  diagonal (the rigid form is the bar-and-hinge model's limit of infinite stiffness ratio, the
+  deviation from it scales with the compliance). A scene driven by actuators alone has no
+  loads: the rigid form's error is its largest fold-angle difference from a coarse
+  bar-and-hinge solve of the scene (its actuated creases are springs that the other creases
+  and the panels hold back); the scene's own model is the reference for that output.
+
+Limitations: the estimates are linear at the reference state (actuators play no part in
+them); a subdivided model is built for scenes without actuators (the actuated creases would
+be cut into pieces), so an actuated scene that needs one is refused by
+:func:`subdivided_scene` with a one-line error.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+import time
+from typing import Any
+
+import numpy as np
+
+from barhinge.errors import ConfigError, ConvergenceError
+
+__all__ = [
+    "OUTPUTS",
+    "Candidate",
+    "ModelChoice",
+    "choose_model",
+    "parse_accuracy",
+    "richardson",
+    "scene_for_accuracy",
+    "subdivided_scene",
+]
+
+#: outputs an accuracy can be asked for
+OUTPUTS = ("stiffness", "displacement", "form")
+#: subdivision levels tried, coarsest first
+LEVELS = (2, 4, 8, 16)
+
+
+@dataclasses.dataclass(frozen=True)
+class Candidate:
+    """One model tried: ``name`` ("rigid", "N4B5", "N5B8", "N5B8 m=4"), its size, the outputs
+    of its linear response and its estimated relative error per output."""
+
+    name: str
+    scheme: str
+    m: int
+    n_dof: int
+    values: dict[str, float]
+    errors: dict[str, float]
+    time_s: float
+
+    @property
+    def error(self) -> float:
+        """The largest estimated error over the requested outputs."""
+        return max(self.errors.values(), default=0.0)
+
+
+@dataclasses.dataclass(frozen=True)
+class ModelChoice:
+    """The answer of :func:`choose_model`: the chosen candidate, every candidate tried, the
+    extrapolated reference per output and its observed rate in m."""
+
+    chosen: Candidate
+    candidates: tuple[Candidate, ...]
+    accuracy: float
+    outputs: tuple[str, ...]
+    reference: dict[str, float]
+    rate: dict[str, float]
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready record for the run summary."""
+        return {
+            "model": self.chosen.name,
+            "accuracy_requested": self.accuracy,
+            "estimated_error": self.chosen.errors,
+            "outputs": list(self.outputs),
+            "reference": self.reference,
+            "observed_rate": self.rate,
+            "candidates": [
+                {"model": c.name, "n_dof": c.n_dof, "estimated_error": c.errors, "time_s": c.time_s}
+                for c in self.candidates
+            ],
+        }
+
+
+def parse_accuracy(text: str | float) -> float:
+    """``"2%"``, ``"2 %"``, ``"0.02"`` or 0.02 -> 0.02 (a relative accuracy in (0, 1))."""
+    if isinstance(text, (int, float)):
+        val = float(text)
+    else:
+        s = str(text).strip()
+        mm = re.fullmatch(r"([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*(%?)", s)
+        if mm is None:
+            raise ConfigError(f"accuracy {text!r}; expected a percentage such as 2% or a fraction")
+        val = float(mm.group(1)) / (100.0 if mm.group(2) else 1.0)
+    if not 0.0 < val < 1.0:
+        raise ConfigError(f"accuracy = {val:g}; expected a relative accuracy in (0, 1) (e.g. 2%)")
+    return val
+
+
+def richardson(values: list[float]) -> tuple[float, float, float]:
+    """(reference, observed rate p in m, |correction|) from values on m, 2m, 4m...:
+    Richardson with ``p = log2(d1 / d2)`` of the last two differences when they shrink
+    monotonically; otherwise the finest value with the last change as its correction."""
+    if len(values) >= 3:
+        d1, d2 = values[-2] - values[-3], values[-1] - values[-2]
+        if d1 * d2 > 0 and abs(d2) < abs(d1):
+            p = math.log2(d1 / d2)
+            corr = d2 / (2.0**p - 1.0)
+            return values[-1] + corr, p, abs(corr)
+    if len(values) >= 2:
+        return values[-1], float("nan"), abs(values[-1] - values[-2])
+    return values[-1], float("nan"), float("inf")
+
+
+def _crease_k_per_length(model) -> np.ndarray:
+    """(n_edges,) fold stiffness per unit length of each pattern edge's fold hinge (0 where
+    there is none)."""
+    X = np.asarray(model.X0)
+    h = model.hinges
+    fold = (model.hinge_kind == "fold") & (model.hinge_edge >= 0)
+    ell = np.linalg.norm(X[h[fold, 1]] - X[h[fold, 0]], axis=1)
+    out = np.zeros(model.pattern.n_edges)
+    out[model.hinge_edge[fold]] = model.hinge_k[fold] / ell
+    return out
+
+
+def subdivided_scene(scene, m: int, scheme: str = "N5B8"):
+    """The scene with its pattern cut into ``m x m`` cells (``m = 1``: the scene's pattern
+    with ``scheme``): plate-consistent bending (m > 1), the crease stiffness per length of
+    ``scene.model``, supports and loads kept on the pattern's vertices; a vertex added on an
+    edge whose two ends are supported is supported in the directions both ends share."""
+    from barhinge.model.model import BarHingeModel
+    from barhinge.model.plate_hinges import consistent_hinge_stiffness
+    from barhinge.pattern.subdivide import subdivided
+
+    base = scene.model
+    if m > 1 and scene.actuators is not None and scene.actuators.n:
+        raise ConfigError(
+            "a subdivided model of an actuated scene is not built (its actuated creases would "
+            "be cut); ask for a coarser accuracy or remove the actuators"
+        )
+    if m == 1 and scheme == base.scheme:
+        return scene
+    cp = base.pattern
+    cpm, parent = subdivided(cp, m)
+    kw = {k: base.meta[k] for k in ("bar_calibration",) if k in base.meta}
+    cal = base.meta.get("bend_calibration", "filipov") if m == 1 else "kirchhoff"
+    model = BarHingeModel.from_pattern(cpm, scheme, base.material, bend_calibration=cal, **kw)
+    # creases: the base model's stiffness per unit length, on every piece of the edge
+    kpl = _crease_k_per_length(base)
+    n_e = cp.n_edges
+    child_parent = np.concatenate(
+        [np.repeat(np.arange(n_e), m), np.full(cpm.n_edges - n_e * m, -1)]
+    )
+    k = np.array(model.hinge_k)
+    X = np.asarray(model.X0)
+    h = model.hinges
+    fold = (model.hinge_kind == "fold") & (model.hinge_edge >= 0)
+    pe = child_parent[np.maximum(model.hinge_edge, 0)]
+    on_parent = fold & (pe >= 0)
+    ell = np.linalg.norm(X[h[:, 1]] - X[h[:, 0]], axis=1)
+    k[on_parent] = kpl[pe[on_parent]] * ell[on_parent]
+    model = model.with_(hinge_k=k)
+    if m > 1:
+        model = model.with_(hinge_k=consistent_hinge_stiffness(model).hinge_k)
+    nv = cp.n_vertices
+    S = np.zeros((model.n_nodes, 3), bool)
+    F = np.zeros((model.n_nodes, 3))
+    if scene.supports is not None:
+        S0 = np.asarray(scene.supports, bool)[:nv]
+        S[:nv] = S0
+        new = np.flatnonzero(parent >= 0)
+        E = np.asarray(cp.edges)
+        ends = E[parent[new]]
+        S[new] = S0[ends[:, 0]] & S0[ends[:, 1]]
+    else:
+        S = None
+    if scene.loads is not None:
+        F = _spread_loads(cp, np.asarray(scene.loads, float)[:nv], cpm, m, model.n_nodes)
+    return dataclasses.replace(scene, model=model, supports=S, loads=F, prescribed=None)
+
+
+def _face_areas(V: np.ndarray, faces) -> np.ndarray:
+    return np.array(
+        [
+            0.5 * np.linalg.norm(np.cross(V[list(f)], np.roll(V[list(f)], -1, 0)).sum(0))
+            for f in faces
+        ]
+    )
+
+
+def _spread_loads(cp, Fv: np.ndarray, cpm, m: int, n_nodes: int) -> np.ndarray:
+    """(n_nodes, 3) loads of the subdivided pattern: the scene's vertex loads read as a
+    distributed load (each vertex's load over its tributary area, sum of area / corners of
+    the faces around it; each face carrying the mean of its corners' densities), lumped
+    equally to the corners of every cell. A uniform load lumped that way is reproduced."""
+    V = np.asarray(cp.vertices3d, float)
+    A = _face_areas(V, cp.faces)
+    trib = np.zeros(len(V))
+    for f, a in zip(cp.faces, A, strict=True):
+        trib[list(f)] += a / len(f)
+    dens = np.divide(Fv, trib[:, None], out=np.zeros_like(Fv), where=trib[:, None] > 0)
+    face_q = np.array([dens[list(f)].mean(axis=0) for f in cp.faces])
+    Vm = np.asarray(cpm.vertices3d, float)
+    cells = cpm.faces
+    Ac = _face_areas(Vm, cells)
+    parent = np.repeat(np.arange(cp.n_faces), m * m)
+    F = np.zeros((n_nodes, 3))
+    for c, a, pf in zip(cells, Ac, parent, strict=True):
+        F[list(c)] += face_q[pf] * a / len(c)
+    # loads on vertices of no face (none in a valid pattern) are kept as they are
+    free = trib == 0
+    F[: len(V)][free] += Fv[free]
+    return F
+
+
+def _response(scene) -> tuple[dict[str, float], int]:
+    from barhinge.analysis.stiffness import linear_response
+    from barhinge.scene import restraint_321
+
+    model = scene.model
+    S = scene.supports if scene.supports is not None else restraint_321(model)
+    F = np.zeros((model.n_nodes, 3)) if scene.loads is None else np.asarray(scene.loads, float)
+    U, _ = linear_response(model, F, np.asarray(S, bool))
+    fu = float(np.sum(F * U))
+    Qt = float(np.linalg.norm(F.sum(axis=0)))
+    nv = model.pattern.n_vertices
+    vals = {
+        "stiffness": Qt**2 / fu if fu > 0 else float("inf"),
+        "displacement": float(np.linalg.norm(U[:nv], axis=1).max()),
+    }
+    return vals, 3 * model.n_nodes
+
+
+def _rel(a: float, b: float) -> float:
+    return abs(a / b - 1.0) if b != 0 else (0.0 if a == 0 else float("inf"))
+
+
+def choose_model(
+    scene,
+    accuracy: float | str = 0.02,
+    outputs: tuple[str, ...] | list[str] = ("stiffness",),
+    max_m: int = 16,
+) -> ModelChoice:
+    """The lightest model of ``scene`` whose estimated error meets ``accuracy`` for every
+    requested output (module docstring).
+
+    Raises
+    ------
+    ConfigError
+        Unknown output, bad accuracy.
+    ConvergenceError
+        No candidate up to ``max_m`` meets the accuracy; the message names the best estimate.
+    """
+    from barhinge.solver.form import form_only_model
+
+    acc = parse_accuracy(accuracy)
+    outs = tuple(outputs)
+    for o in outs:
+        if o not in OUTPUTS:
+            raise ConfigError(f"output {o!r} is unknown; expected one of {OUTPUTS}")
+    if form_only_model(scene)[0] == "rigid":
+        return _choose_actuated(scene, acc, outs)
+    if scene.loads is None or not np.any(scene.loads):
+        raise ConfigError("the scene has neither loads nor only actuators: nothing to estimate")
+    X = np.asarray(scene.model.X0)
+    size = float(np.linalg.norm(np.ptp(X, axis=0)))
+    runs: list[tuple[str, str, int, dict[str, float], int, float]] = []
+
+    # the estimates are linear responses at the reference state: actuators play no part
+    static = dataclasses.replace(scene, actuators=None)
+
+    def run(scheme: str, m: int) -> dict[str, float]:
+        t0 = time.perf_counter()
+        vals, ndof = _response(subdivided_scene(static, m, scheme))
+        name = scheme if m == 1 else f"{scheme} m={m}"
+        runs.append((name, scheme, m, vals, ndof, time.perf_counter() - t0))
+        return vals
+
+    for scheme in ("N4B5", "N5B8"):
+        run(scheme, 1)
+    levels = [m for m in LEVELS if m <= max_m]
+    seq: list[dict[str, float]] = []
+    ref: dict[str, float] = {}
+    rate: dict[str, float] = {}
+    unc: dict[str, float] = {}
+    for m in levels:
+        seq.append(run("N5B8", m))
+        for q in ("stiffness", "displacement"):
+            ref[q], rate[q], unc[q] = richardson([v[q] for v in seq])
+        if len(seq) >= 3 and all(_est(seq[-1], ref, unc, size, o) <= acc for o in outs):
+            break
+    cands = [
+        Candidate("rigid", "rigid", 1, 0, {}, {o: _rigid_error(ref, size, o) for o in outs}, 0.0)
+    ]
+    for name, scheme, m, vals, ndof, dt in runs:
+        cands.append(
+            Candidate(
+                name, scheme, m, ndof, vals, {o: _est(vals, ref, unc, size, o) for o in outs}, dt
+            )
+        )
+    ok = [c for c in cands if c.error <= acc]
+    if not ok:
+        best = min(cands, key=lambda c: c.error)
+        raise ConvergenceError(
+            f"no model up to m = {levels[-1]} meets the accuracy {100 * acc:g} %: the best "
+            f"estimate is {100 * best.error:.2g} % ({best.name})"
+        )
+    return ModelChoice(ok[0], tuple(cands), acc, outs, ref, rate)
+
+
+def _est(vals, ref, unc, size: float, out: str) -> float:
+    """Estimated relative error of one output of a candidate."""
+    if out == "form":
+        return (abs(vals["displacement"] - ref["displacement"]) + unc["displacement"]) / size
+    return _rel(vals[out], ref[out]) + unc[out] / abs(ref[out])
+
+
+def _rigid_error(ref, size: float, out: str) -> float:
+    """The rigid form: no elastic displacement (error 100 % in stiffness and displacement)."""
+    return ref["displacement"] / size if out == "form" else 1.0
+
+
+#: load steps of the coarse bar-and-hinge solve that estimates the rigid form's error
+ESTIMATE_STEPS = 10
+
+
+def _choose_actuated(scene, acc: float, outs: tuple[str, ...]) -> ModelChoice:
+    """A scene driven by actuators alone: the rigid form against the scene's own model,
+    the rigid form's error = largest fold-angle difference at the end of the path over the
+    largest fold angle, from a coarse bar-and-hinge solve (``ESTIMATE_STEPS`` steps)."""
+    from barhinge.errors import BarhingeError
+    from barhinge.solver.form import rigid_form
+    from barhinge.solver.newton import solve
+
+    if any(o != "form" for o in outs):
+        raise ConfigError(
+            "a scene driven by actuators alone has no loads: ask for the form (outputs 'form')"
+        )
+    t0 = time.perf_counter()
+    coarse = solve(dataclasses.replace(scene, steps=min(scene.steps, ESTIMATE_STEPS)))
+    t_bh = time.perf_counter() - t0
+    b = np.asarray(coarse.fold_angles_deg[-1])
+    t0 = time.perf_counter()
+    try:
+        a = np.asarray(rigid_form(scene).fold_angles_deg[-1])
+        err = float(np.abs(a - b).max() / max(float(np.abs(b).max()), 1e-12))
+    except BarhingeError:
+        err = float("inf")
+    t_r = time.perf_counter() - t0
+    model = scene.model
+    rigid = Candidate("rigid", "rigid", 1, 0, {}, {"form": err}, t_r)
+    own = Candidate(model.scheme, model.scheme, 1, 3 * model.n_nodes, {}, {"form": 0.0}, t_bh)
+    chosen = rigid if err <= acc else own
+    return ModelChoice(chosen, (rigid, own), acc, outs, {}, {})
+
+
+def scene_for_accuracy(scene, accuracy: float | str, outputs: tuple[str, ...] | None = None):
+    """(scene to run, ModelChoice): the scene rebuilt on the model :func:`choose_model` picks
+    (the scene itself for the rigid form or the scene's own model). ``outputs`` default:
+    the form for a scene driven by actuators alone, else the stiffness."""
+    from barhinge.solver.form import form_only_model
+
+    if not outputs:
+        outputs = ("form",) if form_only_model(scene)[0] == "rigid" else ("stiffness",)
+    ch = choose_model(scene, accuracy, outputs)
+    c = ch.chosen
+    if c.name == "rigid" or (c.m == 1 and c.scheme == scene.model.scheme):
+        return scene, ch
+    return subdivided_scene(scene, c.m, c.scheme), ch

@@ -1,0 +1,261 @@
+"""Plate-consistent hinge stiffnesses for finely subdivided panels (:func:`consistent_bending`).
+
+A sheet cut into many small flat cells (``barhinge.pattern.subdivide.subdivided``) bends
+through its hinges: the bend hinges inside each N5B8 cell (corner to centre) and the fold
+hinges of the flat ``F`` lines between cells. The rule here chooses their stiffnesses so that
+every *uniform curvature* ``w = (k11 x^2 + k22 y^2) / 2 + k12 x y`` of a cell stores the
+Kirchhoff plate energy per unit area
+
+    U = D / 2 (k11^2 + k22^2 + 2 nu k11 k22 + 2 (1 - nu) k12^2)  +  lambda (k11 k22 - k12^2)
+
+(``D = E t^3 / (12 (1 - nu^2))``; the last term, the linearised Gaussian curvature, is a null
+Lagrangian: its integral is a boundary term that vanishes wherever ``w = 0`` along straight
+supported edges, so ``lambda`` is a free parameter of the fit). This is the patch test of
+plate elements: a hinge model that passes it on a regular mesh converges to the plate as the
+cells shrink; one that fails it converges to a different (anisotropic) plate.
+
+How (per cell, in the cell's own plane): the linearised dihedral angle of a hinge with axis
+``a -> b`` and wing nodes ``p`` is ``sum_p (w_p - w_axis(p)) / dist(p, axis)``; for a uniform
+curvature each angle is linear in ``(k11, k22, k12, delta)``, ``delta`` the offset of the
+centre nodes from the quadratic (the structure relaxes it: condensed out); the neighbour cell
+across a side is taken as the point reflection of the cell through the side's midpoint (exact
+for the parallelogram and barycentric-triangle grids of ``subdivided``). Hinge energies
+``k theta^2 / 2`` (a side hinge shared by two cells counts half per cell). Stiffnesses per
+hinge group (opposite sides, the two halves of a diagonal; the three sides of a triangle) and
+``lambda`` by bounded least squares (``k >= 0``), relative to ``D``. The fit is exact
+(residual ~1e-12) for squares (every hinge ``4 D / 3``, ``lambda = -(1/3 + nu) D``),
+rectangles of aspect ratio up to about 1.6, equilateral triangles (``2 D / sqrt 3``) and
+the 60-degree rhombus (only as its long-diagonal hinges become near rigid, ~3e4 D); it
+leaves a residual for elongated rectangles, oblique parallelograms and right or isosceles
+triangles, which is reported (``PlateHinges.residual``): such cells converge to a plate with
+the wrong anisotropy, not to the Kirchhoff plate.
+
+Sources: the patch test of nonconforming plate elements (Morley 1968; Irons & Razzaque 1972);
+dihedral-angle bending energies and their mesh dependence (Grinspun, Hirani, Desbrun &
+Schroeder 2003, "Discrete shells"; Wardetzky, Bergou, Harmon, Zorin & Grinspun 2007,
+"Discrete quadratic curvature energies").
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+
+import numpy as np
+
+from barhinge.errors import ConfigError
+from barhinge.model.model import BarHingeModel
+
+logger = logging.getLogger(__name__)
+
+__all__ = ["PlateHinges", "cell_fit", "consistent_bending", "consistent_hinge_stiffness"]
+
+#: weight of the pull of each hinge group towards 4/3 D in the cell fit (log scale)
+REGULARISATION = 1e-3
+#: relative rounding of cell shapes (normalised by sqrt(area)) when grouping equal cells
+SHAPE_DIGITS = 6
+
+
+@dataclasses.dataclass(frozen=True)
+class PlateHinges:
+    """Result of :func:`consistent_hinge_stiffness`.
+
+    Attributes
+    ----------
+    hinge_k : (n_hinges,) float, moment per radian: the model's stiffnesses with the bend
+        hinges and the ``F``-line fold hinges replaced (creases keep theirs)
+    residual : (n_faces,) float, largest entry of the cell's energy mismatch over ``D``
+        (0 = the cell passes the uniform-curvature patch test)
+    changed : (n_hinges,) bool, hinges whose stiffness the rule set (every hinge inside or
+        between cells; creases get their spring in series with the plate strip)
+    """
+
+    hinge_k: np.ndarray
+    residual: np.ndarray
+    changed: np.ndarray
+
+
+def _coef(p: np.ndarray) -> np.ndarray:
+    """Coefficients of (k11, k22, k12) in w at the points p (..., 2)."""
+    x, y = p[..., 0], p[..., 1]
+    return np.stack([x * x / 2, y * y / 2, x * y], axis=-1)
+
+
+def _angle_row(a, b, wings, da: float = 0.0, db: float = 0.0) -> np.ndarray:
+    """(4,) linearised dihedral angle of the hinge a -> b per (k11, k22, k12, delta); wings
+    is a list of (point, centre flag); da, db: centre flags of the axis ends."""
+    u = b - a
+    g = np.zeros(4)
+    for p, dp in wings:
+        s = float((p - a) @ u / (u @ u))
+        d = float(np.linalg.norm(p - a - s * u))
+        g[:3] += (_coef(p) - (1 - s) * _coef(a) - s * _coef(b)) / d
+        g[3] += (dp - (1 - s) * da - s * db) / d
+    return g
+
+
+def _cell_rows(P: np.ndarray):
+    """Angle rows, energy weights and groups of a cell's hinges, in the order: quad: side i
+    (P_i -> P_i+1) for i = 0..3, then half-diagonal P_i -> centre; triangle: side i."""
+    rows, w, grp = [], [], []
+    if len(P) == 4:
+        c = P.mean(axis=0)
+        for i in range(4):
+            a, b = P[i], P[(i + 1) % 4]
+            rows.append(_angle_row(a, b, [(c, 1.0), (a + b - c, 1.0)]))
+            w.append(0.5)
+            grp.append(i % 2)
+        for i in range(4):
+            rows.append(_angle_row(P[i], c, [(P[(i + 1) % 4], 0.0), (P[i - 1], 0.0)], 0.0, 1.0))
+            w.append(1.0)
+            grp.append(2 + i % 2)
+    else:
+        for i in range(3):
+            a, b, o = P[i], P[(i + 1) % 3], P[(i + 2) % 3]
+            rows.append(_angle_row(a, b, [(o, 0.0), (a + b - o, 0.0)]))
+            w.append(0.5)
+            grp.append(i)
+    return np.array(rows), np.array(w), np.array(grp)
+
+
+def _condensed(k: np.ndarray, rows: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """(3, 3) energy form in (k11, k22, k12) with the centre offset condensed out."""
+    M = np.einsum("hi,h,hj->ij", rows, w * k, rows)
+    if M[3, 3] > 1e-300:
+        return M[:3, :3] - np.outer(M[:3, 3], M[3, :3]) / M[3, 3]
+    return M[:3, :3]
+
+
+def cell_fit(P: np.ndarray, nu: float) -> tuple[np.ndarray, float, float]:
+    """Hinge stiffnesses over D of one flat cell (module docstring).
+
+    Parameters
+    ----------
+    P : (4, 2) or (3, 2) float, corners counter-clockwise in the cell's plane
+    nu : Poisson's ratio
+
+    Returns
+    -------
+    k : (8,) or (3,) float, stiffness / D per hinge in the order of ``_cell_rows``
+    lam : float, the null-Lagrangian coefficient / D
+    residual : float, largest |entry| of the energy-form mismatch / D
+    """
+    from scipy.optimize import least_squares  # lazy: scipy.optimize is slow to import
+
+    rows, w, grp = _cell_rows(np.asarray(P, float))
+    area = 0.5 * abs(float(np.sum(P[:, 0] * np.roll(P[:, 1], -1) - np.roll(P[:, 0], -1) * P[:, 1])))
+    plate = np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 2.0 * (1.0 - nu)]])
+    null = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -2.0]])
+    ng = int(grp.max()) + 1
+
+    def mismatch(x: np.ndarray) -> np.ndarray:
+        return (_condensed(x[:ng][grp], rows, w) / area - plate - x[ng] * null).ravel()
+
+    def objective(x: np.ndarray) -> np.ndarray:
+        # the energy rows, and a weak pull of every stiffness towards the square cell's
+        # 4/3: where the energy does not fix a group (a family of exact fits) the fit
+        # takes the moderate member instead of a near-rigid hinge, which would lock
+        return np.concatenate([mismatch(x), REGULARISATION * np.log(x[:ng] / (4.0 / 3.0))])
+
+    x0 = np.append(np.full(ng, 4.0 / 3.0), -(1.0 / 3.0 + nu))
+    lo = np.append(np.full(ng, 1e-6), -np.inf)
+    sol = least_squares(objective, x0, bounds=(lo, np.inf), xtol=1e-14, ftol=1e-14, gtol=1e-14)
+    # polish without the pull: the exact fit next to the moderate one
+    sol = least_squares(mismatch, sol.x, bounds=(lo, np.inf), xtol=1e-14, ftol=1e-14, gtol=1e-14)
+    return sol.x[:ng][grp], float(sol.x[ng]), float(np.abs(mismatch(sol.x)).max())
+
+
+def _cells_2d(X: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """(nf, k, 2) corners of the faces F (nf, k) in their own planes (origin corner 0,
+    first axis along side 0)."""
+    P = X[F]
+    n = np.cross(P, np.roll(P, -1, axis=1)).sum(axis=1)
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    e1 = P[:, 1] - P[:, 0]
+    e1 /= np.linalg.norm(e1, axis=1)[:, None]
+    e2 = np.cross(n, e1)
+    R = P - P[:, :1]
+    return np.stack([np.einsum("fki,fi->fk", R, e1), np.einsum("fki,fi->fk", R, e2)], axis=-1)
+
+
+def consistent_hinge_stiffness(model: BarHingeModel) -> PlateHinges:
+    """Plate-consistent stiffnesses of the bend hinges and the ``F``-line fold hinges of an
+    N5B8 model of a (subdivided) pattern with triangular or quadrilateral faces (module
+    docstring). A crease (M, V, U) hinge gets its spring ``k_c`` in series with the plate
+    strip ``k_s`` of the two half-cells beside it, ``k_c k_s / (k_c + k_s)``: its angle is the
+    crease's own rotation plus the bending of that strip."""
+    cp = model.pattern
+    if model.scheme != "N5B8":
+        raise ConfigError(f"consistent bending needs an N5B8 model, got {model.scheme}")
+    sizes = np.array([len(f) for f in cp.faces])
+    if not np.isin(sizes, (3, 4)).all():
+        raise ConfigError("consistent bending needs triangular or quadrilateral faces")
+    mat = model.material
+    D, nu = mat.bending_rigidity, mat.nu
+    X = np.asarray(model.X0, float)
+    nv = cp.n_vertices
+    E = np.asarray(cp.edges, np.int64)
+    ekey = np.minimum(E[:, 0], E[:, 1]) * nv + np.maximum(E[:, 0], E[:, 1])
+    eorder = np.argsort(ekey)
+    side_k = np.zeros(len(E))  # summed half contributions of the cells on each edge
+    residual = np.zeros(cp.n_faces)
+    h = np.asarray(model.hinges)
+    bend = np.asarray(model.hinge_kind) == "bend"
+    hface = np.asarray(model.hinge_face)
+    corner = np.minimum(h[:, 0], h[:, 1])
+    hkey = np.where(bend, hface * nv + corner, -1)
+    horder = np.argsort(hkey)
+    k_new = np.array(model.hinge_k, float)
+    for size in (3, 4):
+        fids = np.flatnonzero(sizes == size)
+        if not len(fids):
+            continue
+        F = np.array([cp.faces[f] for f in fids], np.int64)
+        P2 = _cells_2d(X, F)
+        area = 0.5 * np.abs(
+            np.sum(
+                P2[..., 0] * np.roll(P2[..., 1], -1, 1) - np.roll(P2[..., 0], -1, 1) * P2[..., 1], 1
+            )
+        )
+        key = np.round(P2 / np.sqrt(area)[:, None, None], SHAPE_DIGITS).reshape(len(fids), -1)
+        _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
+        fits = [cell_fit(P2[f], nu) for f in first]
+        kc = np.array([f[0] for f in fits])[inv.ravel()] * D  # (nf, n hinges of the cell)
+        residual[fids] = np.array([f[2] for f in fits])[inv.ravel()]
+        # sides: half of the cell's side stiffness to the edge
+        a, b = F, np.roll(F, -1, axis=1)
+        sk = np.minimum(a, b) * nv + np.maximum(a, b)
+        e = eorder[np.searchsorted(ekey, sk, sorter=eorder)]
+        np.add.at(side_k, e.ravel(), 0.5 * kc[:, :size].ravel())
+        if size == 4:
+            hk = fids[:, None] * nv + F
+            pos = np.searchsorted(hkey, hk, sorter=horder)
+            hid = horder[np.minimum(pos, len(h) - 1)]
+            if not np.array_equal(hkey[hid], hk):
+                raise ConfigError("N5B8 model and pattern disagree on the cells' diagonals")
+            k_new[hid.ravel()] = kc[:, 4:].ravel()
+    flat_line = ~bend & (np.asarray(model.hinge_edge) >= 0)
+    flat_line &= np.asarray(cp.assignment)[np.maximum(model.hinge_edge, 0)] == "F"
+    k_new[flat_line] = side_k[np.asarray(model.hinge_edge)[flat_line]]
+    # creases: the crease spring in series with the plate strip of the two half-cells
+    # beside it (the hinge's angle is the crease's own rotation plus the strip's bending)
+    crease = ~bend & ~flat_line & (np.asarray(model.hinge_edge) >= 0)
+    ks = side_k[np.asarray(model.hinge_edge)[crease]]
+    kc = k_new[crease]
+    with np.errstate(divide="ignore"):
+        k_new[crease] = np.where((ks > 0) & (kc > 0), kc * ks / (kc + ks), kc)
+    logger.debug(
+        "consistent bending: %d bend + %d flat-line hinges, largest cell residual %.2g",
+        int(bend.sum()),
+        int(flat_line.sum()),
+        float(residual.max(initial=0.0)),
+    )
+    changed = bend | flat_line
+    changed[np.flatnonzero(crease)[(ks > 0) & (kc > 0)]] = True
+    return PlateHinges(hinge_k=k_new, residual=residual, changed=changed)
+
+
+def consistent_bending(model: BarHingeModel) -> BarHingeModel:
+    """The model with the plate-consistent bend and flat-line hinge stiffnesses of
+    :func:`consistent_hinge_stiffness`."""
+    return model.with_(hinge_k=consistent_hinge_stiffness(model).hinge_k)

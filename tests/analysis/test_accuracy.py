@@ -1,0 +1,115 @@
+"""``--accuracy``: the lightest model meeting a requested accuracy (barhinge.analysis.accuracy).
+
+References: a roof-like Miura sheet's stiffness extrapolated from finer levels than the chooser
+computes (m = 8, 16, 32; Richardson); the default Miura scene's form from the bar-and-hinge
+solver.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import barhinge as bh
+from barhinge.analysis.accuracy import (
+    _response,
+    choose_model,
+    parse_accuracy,
+    richardson,
+    subdivided_scene,
+)
+from barhinge.errors import ConfigError
+from barhinge.scene import Scene, default_scene
+from barhinge.solver.form import rigid_form
+
+MAT = bh.Material(E=70e9, nu=0.33, t=2e-3)
+
+
+def test_parse_accuracy():
+    assert parse_accuracy("2%") == pytest.approx(0.02)
+    assert parse_accuracy("0.5 %") == pytest.approx(0.005)
+    assert parse_accuracy(0.1) == pytest.approx(0.1)
+    for bad in ("two", "0%", "150%", -0.1):
+        with pytest.raises(ConfigError, match="accuracy"):
+            parse_accuracy(bad)
+
+
+def test_richardson_recovers_a_power_law():
+    # s(m) = 3 + 2 m^-1.5: exact limit and rate from three levels
+    vals = [3 + 2 * m**-1.5 for m in (4, 8, 16)]
+    ref, p, corr = richardson(vals)
+    assert ref == pytest.approx(3.0, rel=1e-12)
+    assert p == pytest.approx(1.5, rel=1e-12)
+
+
+def _roof(fold: float = 50.0) -> Scene:
+    """A 2 x 2 Miura sheet pinned along its two y-ends under a downward load on every
+    vertex (the same nodal loads at every subdivision level)."""
+    cp = bh.families.miura(nx=2, ny=2, fold=fold)
+    model = bh.BarHingeModel.from_pattern(cp, "N5B8", MAT)
+    V = np.asarray(cp.vertices3d)
+    y = V[:, 1]
+    S = np.zeros((model.n_nodes, 3), bool)
+    S[np.flatnonzero((y < y.min() + 1e-9) | (y > y.max() - 1e-9))] = True
+    F = np.zeros((model.n_nodes, 3))
+    F[: cp.n_vertices, 2] = -100.0
+    return Scene(model=model, supports=S, loads=F, name="miura roof")
+
+
+@pytest.mark.parametrize("target", ["20%", "10%"])
+def test_choice_meets_its_target_against_a_finer_reference(target):
+    scene = _roof()
+    ch = choose_model(scene, target)
+    acc = parse_accuracy(target)
+    assert ch.chosen.error <= acc
+    assert ch.chosen.name != "rigid"
+    fine = [_response(subdivided_scene(scene, m))[0]["stiffness"] for m in (8, 16, 32)]
+    ref = richardson(fine)[0]
+    assert abs(ch.chosen.values["stiffness"] / ref - 1.0) <= acc
+    # lighter candidates were estimated above the target
+    lighter = ch.candidates[: ch.candidates.index(ch.chosen)]
+    assert all(c.error > acc for c in lighter)
+
+
+@pytest.mark.parametrize("target", ["2%", "15%"])
+def test_actuated_scene_rigid_form_only_when_it_meets_the_target(target):
+    scene = default_scene()
+    ch = choose_model(scene, target, outputs=("form",))
+    path = bh.solve(scene)  # the reference: the scene's own model, all its steps
+    rigid = rigid_form(scene)
+    a, b = rigid.fold_angles_deg[-1], path.fold_angles_deg[-1]
+    true_err = np.abs(a - b).max() / np.abs(b).max()
+    rigid_est = ch.candidates[0].errors["form"]
+    assert rigid_est == pytest.approx(true_err, rel=0.1)
+    if ch.chosen.name == "rigid":
+        assert true_err <= parse_accuracy(target)
+    else:
+        assert true_err > parse_accuracy(target) * 0.9 and ch.chosen.name == scene.model.scheme
+
+
+def test_bad_outputs_and_unreachable_accuracy_are_named_errors():
+    with pytest.raises(ConfigError, match="output"):
+        choose_model(_roof(), "2%", outputs=("stress",))
+    with pytest.raises(bh.errors.ConvergenceError, match="no model up to m = 2"):
+        choose_model(_roof(), "0.1%", max_m=2)
+
+
+def test_cli_fold_accuracy(tmp_path, capsys):
+    import json
+
+    from typer.testing import CliRunner
+
+    from barhinge.cli import app
+
+    out = tmp_path / "run"
+    res = CliRunner().invoke(app, ["fold", "--out", str(out), "--accuracy", "15%", "--no-viewer"])
+    assert res.exit_code == 0, res.output
+    choice = json.loads((out / "summary.json").read_text())["model_choice"]
+    assert choice["model"] == "rigid" and choice["estimated_error"]["form"] <= 0.15
+    from barhinge.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["fold", "--out", str(tmp_path / "bad"), "--accuracy", "two"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "accuracy" in err and "Traceback" not in err

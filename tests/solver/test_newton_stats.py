@@ -1,0 +1,75 @@
+"""Per-step Newton statistics (``FoldPath.meta["newton"]``) against independent counts:
+factorisations counted by wrapping the bordered system's factorisation, per step through the
+progress callback; failed increments counted by wrapping the increment itself."""
+
+from __future__ import annotations
+
+import numpy as np
+
+import barhinge as bh
+import barhinge.solver.newton as newton
+from barhinge.families import miura_line_creases
+from barhinge.model.model import BarHingeModel
+from barhinge.scene import Scene
+from barhinge.solver.bordered import BorderedSystem
+
+
+def _scene(steps: int = 6) -> Scene:
+    cp0 = bh.families.miura(3, 3, alpha=60.0, fold=0.0)
+    cp1 = bh.families.miura(3, 3, alpha=60.0, fold=60.0)
+    edges = miura_line_creases(cp0)
+    model = BarHingeModel.from_pattern(cp0, "N5B8", fold_stiffness=0.1, bar_EA=1e3)
+    acts = bh.Actuators(edges=edges, targets_deg=np.asarray(cp1.fold_angles)[edges])
+    # few long steps from flat: the first increments are cut back (max_iter 8: with the
+    # softer plate-calibrated panels 6 iterations no longer converge at any step size)
+    return Scene(model, actuators=acts, steps=steps, options={"max_iter": 8})
+
+
+def test_newton_stats_match_independent_counts(monkeypatch):
+    count = {"fact": 0, "failed": 0}
+    orig_fact = BorderedSystem._factorize_current
+    orig_inc = newton._Driver.increment
+
+    def fact(self, *a, **k):
+        count["fact"] += 1
+        return orig_fact(self, *a, **k)
+
+    def inc(self, *a, **k):
+        try:
+            return orig_inc(self, *a, **k)
+        except newton._Failed:
+            count["failed"] += 1
+            raise
+
+    monkeypatch.setattr(BorderedSystem, "_factorize_current", fact)
+    monkeypatch.setattr(newton._Driver, "increment", inc)
+    at_step = []
+    path = bh.solve(_scene(), progress=lambda done, total, t: at_step.append(count["fact"]))
+    nw = path.meta["newton"]
+    steps = path.meta["steps"]
+    assert nw["iterations"] == path.iterations[1:].tolist()
+    assert len(nw["factorizations"]) == steps
+    # state 0's inertia is one factorisation; every later one belongs to a step
+    np.testing.assert_array_equal(np.diff([1] + at_step), nw["factorizations"])
+    assert (
+        nw["total_factorizations"] + 1 == count["fact"] == path.meta["timing"]["n_factorizations"]
+    )
+    assert nw["total_failed"] == count["failed"]
+    assert count["failed"] > 0  # the scene exercises the cut-backs
+    assert sum(nw["increments"]) >= steps
+    assert all(
+        0 <= i <= f for i, f in zip(nw["inertia_factorizations"], nw["factorizations"], strict=True)
+    )
+
+
+def test_arc_length_lists_iterations():
+    cp = bh.families.miura(2, 2, alpha=60.0, fold=30.0)
+    model = BarHingeModel.from_pattern(cp, "N5B8", fold_stiffness=0.1, bar_EA=1e3)
+    P = np.zeros(model.X0.shape)
+    top = np.argmax(model.X0[:, 2])
+    P[top, 2] = -1e-3
+    sc = Scene(model, loads=P, control="arc_length", steps=4)
+    path = bh.solve(sc)
+    nw = path.meta["newton"]
+    assert nw["iterations"] == path.iterations[1:].tolist()
+    assert nw["total_iterations"] == int(path.iterations.sum())

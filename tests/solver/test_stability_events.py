@@ -1,0 +1,214 @@
+"""Stability monitored in every control, and "converged" means the target was reached.
+
+* The inertia of the free-DOF tangent (actuators released) that the solver reads from its
+  factorisations is checked against dense eigenvalues, on a bordered Miura system made
+  indefinite and along an arc-length path of a Yoshimura roof.
+* The von Mises two-bar truss (half span 1, rise h = 0.3, EA = 1000, Green-strain bars) has
+  the closed-form limit load ``P_max = 2 EA h^3 / (3 sqrt(3) L0^3)`` at apex height
+  ``h / sqrt(3)`` (Krenk 2009, "Non-linear Modeling and Analysis of Solids and Structures",
+  ch. 1); by symmetry of the curve the load minimum is ``-P_max`` at ``-h / sqrt(3)``, and the
+  tangent is negative exactly between the two.
+* Arc length that stops at its step cap, or whose final correction onto load factor 1 fails,
+  raises ConvergenceError with the partial path (``barhinge fold`` exits 3).
+* External work and stored energy agree at the end of a run; the mismatch of the
+  (third-order) work integration falls with the step size at a rate near 3.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+import barhinge as bh
+from barhinge.errors import ConfigError, ConvergenceError
+from barhinge.families import miura_line_creases
+from barhinge.linalg.backends import available_backends, get_backend
+from barhinge.model.model import BarHingeModel
+from barhinge.scene import Scene
+from barhinge.solver import newton
+from barhinge.solver.bordered import BorderedSystem, Timer, actuator_terms
+from barhinge.solver_options import SolverOptions
+from barhinge.verify import von_mises_limit_load, von_mises_model
+
+H_VM = 0.3  # rise of barhinge.verify's von Mises truss
+P_MAX = von_mises_limit_load()
+
+
+def _vm_scene(steps: int = 20, factor: float = 1.5, **opts) -> Scene:
+    model, S, apex = von_mises_model()
+    P = np.zeros((model.n_nodes, 3))
+    P[apex, 2] = -factor * P_MAX
+    options = {"max_arc_steps": 200, **opts}
+    return Scene(model, supports=S, loads=P, control="arc_length", steps=steps, options=options)
+
+
+# ------------------------------------------------------------------ inertia
+@pytest.mark.parametrize("name", available_backends())
+def test_released_inertia_from_the_bordered_factorisation_matches_dense(name):
+    """neg(K_t) = neg([K_t G^T; G 0]) - neg(Y), Y the multiplier block of the inverse
+    (Haynsworth): checked on a Miura tangent shifted to 0, 3, 7 and 11 negative
+    eigenvalues."""
+    cp = bh.families.miura(2, 2, alpha=60.0, fold=30.0)
+    model = BarHingeModel.from_pattern(cp, "N5B8", fold_stiffness=0.1, bar_EA=1e3)
+    edges = miura_line_creases(cp)
+    scene = Scene(model, actuators=bh.Actuators(edges=edges, targets_deg=[30.0] * len(edges)))
+    X = model.X0 + 1e-3 * np.random.default_rng(0).standard_normal(model.X0.shape)
+    K = model.evaluate(X).K
+    terms = actuator_terms(model, X, scene.actuator_hinges())
+    free = ~scene.fixed.ravel()
+    mu = 0.01 * np.arange(1, len(edges) + 1)
+    Kt = K.toarray()
+    for a, dofs in enumerate(terms.dofs):
+        Kt[np.ix_(dofs, dofs)] += mu[a] * terms.hess[a]
+    w = np.linalg.eigvalsh(Kt[np.ix_(free, free)])
+    n0 = int(np.sum(w < 0))  # the perturbed tangent is indefinite already (7)
+    for n_neg in (0, 3, n0, n0 + 4):
+        shift = w[0] - 1.0 if n_neg == 0 else 0.5 * (w[n_neg - 1] + w[n_neg])
+        sysm = BorderedSystem(get_backend(name), free, terms.dofs, Timer())
+        sysm.factorize((K - shift * sp.identity(K.shape[0])).tocsr(), terms, mu, penalty=50.0)
+        got = sysm.tangent_negative_eigenvalues()
+        assert got == int(np.sum(w < shift)) == n_neg, (name, n_neg, got)
+
+
+def test_stability_check_option_is_validated():
+    with pytest.raises(ConfigError, match="stability_check"):
+        SolverOptions(stability_check="yes")
+    assert SolverOptions().exact_inertia("arc_length") and SolverOptions().exact_inertia("load")
+    assert not SolverOptions().exact_inertia("fold_angle")
+    assert SolverOptions(stability_check=True).exact_inertia("displacement")
+
+
+# ------------------------------------------------------------------ von Mises truss
+@pytest.fixture(scope="module")
+def vm_path():
+    return bh.solve(_vm_scene())
+
+
+def test_von_mises_arc_length_reports_the_limit_points(vm_path):
+    p = vm_path
+    lam = 1.5 * p.load_factor  # in units of P_max
+    maxima = [e for e in p.meta["events"] if e.startswith("limit point (load maximum)")]
+    minima = [e for e in p.meta["events"] if e.startswith("limit point (load minimum)")]
+    assert len(maxima) == 1 and len(minima) == 1, p.meta["events"]
+    assert len(p.meta["events"]) == 2  # and nothing else (no work-balance event)
+    at = float(maxima[0].split("load factor ")[1].split()[0]) * 1.5
+    assert at == pytest.approx(1.0, rel=0.01)  # 0.9995 P_max at 20 steps
+    assert at <= lam.max() + 1e-12
+    at_min = float(minima[0].split("load factor ")[1].split()[0]) * 1.5
+    assert at_min == pytest.approx(-1.0, rel=0.01)
+    # the recorded inertia against the closed form: the one free DOF (apex height z) has
+    # negative stiffness exactly for |z| < h / sqrt(3)
+    z = p.X[:, 2, 2]
+    neg = np.array(p.meta["negative_eigenvalues"])
+    clear = np.abs(np.abs(z) - H_VM / math.sqrt(3)) > 1e-3
+    np.testing.assert_array_equal(neg[clear], (np.abs(z[clear]) < H_VM / math.sqrt(3)) * 1)
+
+
+def test_converged_arc_length_ends_exactly_at_load_factor_one(vm_path):
+    p = vm_path
+    assert p.converged and p.load_factor[-1] == pytest.approx(1.0, abs=1e-9)
+    assert np.all(p.load_factor <= 1.0)  # no overshooting state in a converged path
+    wb = p.meta["work_balance"]
+    assert wb["work"] == pytest.approx(p.external_work[-1], rel=1e-15)
+    assert wb["energy"] == pytest.approx(p.energy[-1] - p.energy[0], rel=1e-15)
+    assert wb["rel_mismatch"] < wb["tolerance"] == newton.WORK_TOLERANCE
+    # equilibrium at the final state, from the path alone: reactions balance the load
+    scene = _vm_scene()
+    total = (p.load_factor[-1] * scene.loads + p.reactions[-1]).sum(0)
+    np.testing.assert_allclose(total, 0.0, atol=1e-8 * P_MAX)
+
+
+def test_work_balance_converges_at_third_order():
+    """The mismatch between work and energy is the error of the Simpson work integration
+    (the states are in equilibrium): it falls like h^3 (measured 1.1e-4, 9.4e-6, 5.1e-6,
+    5.7e-8 at 10, 20, 40, 80 steps: fitted slope 3.4, not monotone in between); at 10 arc
+    steps through the whole snap-through it is 1.1e-4, a tenth of the event tolerance."""
+    steps = np.array([10, 20, 40, 80])
+    mis = [bh.solve(_vm_scene(int(s), max_arc_steps=800)).meta["work_balance"] for s in steps]
+    rel = np.array([m["rel_mismatch"] for m in mis])
+    slope = np.polyfit(np.log(1.0 / steps), np.log(rel), 1)[0]
+    assert slope > 2.5, rel
+    assert rel[0] < 0.2 * newton.WORK_TOLERANCE
+
+
+# ------------------------------------------------------------------ failures
+def test_arc_length_step_cap_raises_with_the_partial_path():
+    with pytest.raises(ConvergenceError, match=r"step cap \(max_arc_steps = 10\)") as ei:
+        bh.solve(_vm_scene(max_arc_steps=10))
+    part = ei.value.last_state
+    assert not part.converged and part.n_states == 11
+    assert part.load_factor[-1] < 1.0 and ei.value.load_factor == part.load_factor[-1]
+    assert "of 1" in str(ei.value) and len(part.meta["negative_eigenvalues"]) == 11
+
+
+def test_failed_landing_on_load_factor_one_raises(monkeypatch):
+    def fail(self, st, t1, lam1):
+        raise newton._Failed("residual diverged", [1.0])
+
+    monkeypatch.setattr(newton._Driver, "increment", fail)
+    with pytest.raises(ConvergenceError, match="correction onto 1 failed") as ei:
+        bh.solve(_vm_scene())
+    part = ei.value.last_state
+    assert not part.converged and np.all(part.load_factor < 1.0)
+
+
+def test_cli_fold_exits_3_when_arc_length_stops_at_its_cap(tmp_path, monkeypatch, capsys):
+    from barhinge.cli import main
+    from barhinge.output.summary import run_summary
+
+    scene = (
+        "name = 'roof-arc'\n"
+        "[pattern]\nfamily = 'yoshimura'\nparams = { nx = 3, ny = 2, fold = 30.0 }\n"
+        "[model]\nscheme = 'N5B8'\nmaterial = { E = 1.0e6, nu = 0.3, t = 0.01 }\n"
+        "fold_stiffness = 1.0\n"
+        "[[supports]]\nwhere = 'bottom'\ndofs = 'xyz'\n"
+        "[[supports]]\nwhere = 'top'\ndofs = 'xyz'\n"
+        "[[loads]]\nself_weight = { area_density = 3.0, g = [0.0, 0.0, -9.81] }\n"
+        "[solve]\nsteps = 10\ncontrol = 'arc_length'\noptions = { max_arc_steps = 15 }\n"
+    )  # the roof of data/scenes at 30 times its weight: a limit point at state 13
+    f = tmp_path / "roof.toml"
+    f.write_text(scene)
+    out = tmp_path / "o"
+    monkeypatch.setenv("BARHINGE_PICTURES", "0")  # the result files only: seconds saved
+    monkeypatch.setattr("sys.argv", ["barhinge", "fold", str(f), "--out", str(out)])
+    with pytest.raises(SystemExit) as ex:
+        main()
+    err = capsys.readouterr().err
+    assert ex.value.code == 3, err
+    assert "step cap" in err and "event: limit point (load maximum)" in err
+    part = bh.FoldPath.load(out / "fold_path.npz")
+    assert not part.converged and part.load_factor[-1] < 1.0 and part.n_states == 16
+    info = json.loads((out / "summary.json").read_text())
+    results = info.pop("results")  # the final-state analysis, under its own key
+    assert info == json.loads(json.dumps(run_summary(part)))  # written from the partial path
+    assert results["converged"] is False and results["n_states"] == part.n_states
+    assert not info["converged"] and any("limit point" in e for e in info["events"])
+
+
+# ------------------------------------------------------------------ Yoshimura roof
+def test_yoshimura_roof_going_indefinite_under_arc_length_gets_events():
+    """The roof of data/scenes at 30 times its weight: load control stops at a limit point
+    near load factor 0.70; arc length passes it (and a bifurcation on the way down), records
+    them as events and ends at 1. The recorded inertia is checked against dense eigenvalues
+    of the free-DOF tangent at every state."""
+    base = bh.load_scene(Path(__file__).resolve().parents[2] / "data/scenes/yoshimura_roof.toml")
+    arc = base.with_(loads=30 * base.loads, control="arc_length", steps=10,
+                     options=SolverOptions(max_arc_steps=80))  # fmt: skip
+    p = bh.solve(arc)
+    assert p.converged and p.load_factor[-1] == 1.0
+    ev = p.meta["events"]
+    limit = [e for e in ev if e.startswith("limit point (load maximum)")]
+    assert len(limit) == 1 and any(e.startswith("bifurcation") for e in ev), ev
+    lam_limit = float(limit[0].split("load factor ")[1].split()[0])
+    free = ~arc.fixed.ravel()
+    for i in range(p.n_states):
+        w = np.linalg.eigvalsh(arc.model.evaluate(p.X[i]).K.toarray()[np.ix_(free, free)])
+        assert p.meta["negative_eigenvalues"][i] == int(np.sum(w < 0)), i
+    with pytest.raises(ConvergenceError, match="limit point") as ei:
+        bh.solve(arc.with_(control="load", options=SolverOptions()))
+    assert ei.value.load_factor == pytest.approx(lam_limit, rel=0.01)
