@@ -11,9 +11,9 @@ import pytest
 
 import barhinge as bh
 from barhinge.errors import ConfigError
-from barhinge.kinematics.path import RigidOptions
 from barhinge.families.miura import miura
 from barhinge.families.yoshimura import yoshimura
+from barhinge.kinematics.path import RigidOptions
 
 OPTS = RigidOptions(check_actuators=False)
 # step (degrees): truncation error O(H^2) ~ 1e-9; the finite differences also divide the
