@@ -89,6 +89,11 @@ class RigidOptions:
         is below this (radians).
     energy_max_iter : int
         Newton iterations of that minimisation per step.
+    saddle_shift : bool
+        After leaving a saddle of the energy, keep the multipliers and shift the Lagrangian
+        Hessian past the negative curvature (and wherever the Newton step is not a descent
+        direction) instead of restarting from the spring metric: avoids cycling between
+        saddles (e.g. least-squares Ron Resch sheets); may land on another minimum.
     over_actuated : str
         Actuators whose targets no rigid fold can meet together: ``"least_squares"``
         (default) meets them in least squares (the actuators become stiff springs to their
@@ -106,6 +111,7 @@ class RigidOptions:
     energy_tol: float = 1e-9
     energy_max_iter: int = 40
     over_actuated: str = "least_squares"
+    saddle_shift: bool = False
 
     def __post_init__(self) -> None:
         if self.over_actuated not in ("least_squares", "error"):
@@ -533,7 +539,12 @@ class RigidSolver:
                 return rho, False
             dmax = float(np.max(np.abs(d), initial=0.0))
             log.debug("minimize: |d| %.3e, newton %s, E %.6e", dmax, lam is not None, e0)
-            if lam is not None and dmax > self.opt.energy_tol and float(g[fi] @ d[fi]) >= 0.0:
+            if (
+                self.opt.saddle_shift
+                and lam is not None
+                and dmax > self.opt.energy_tol
+                and float(g[fi] @ d[fi]) >= 0.0
+            ):
                 # not a descent direction: the reduced Hessian is indefinite here; shift it
                 # (Levenberg) instead of converging to the saddle Newton is heading for
                 shift = max(4.0 * shift, shift0)
@@ -548,8 +559,11 @@ class RigidSolver:
                 # keep the multipliers, with the Hessian shifted past the negative curvature
                 # so that Newton descends away from the saddle instead of back to it
                 rho, curv = esc
-                e0, lam, escapes = self.energy(rho), lam_new, escapes + 1
-                shift = max(shift0, -2.0 * curv)
+                e0, escapes = self.energy(rho), escapes + 1
+                if self.opt.saddle_shift:
+                    lam, shift = lam_new, max(shift0, -2.0 * curv)
+                else:
+                    lam = None
                 continue
             if dmax > 0.5:
                 d *= 0.5 / dmax
