@@ -29,6 +29,7 @@ _LAZY = {
     "sweep": "barhinge.sweep",
     "dof": "barhinge.kinematics.dof",
     "rigid_fold": "barhinge.kinematics.path",
+    "rigid_sensitivity": "barhinge.kinematics.sensitivity",
     "BarHingeModel": "barhinge.model.model",
     "Material": "barhinge.model.material",
     "Scene": "barhinge.scene",

@@ -9,15 +9,18 @@ from __future__ import annotations
 from barhinge.kinematics.constraints import NodalConstraints, RigidConstraints, triangulated_pattern
 from barhinge.kinematics.dof import DofReport, dof, folded_sample, select_actuators
 from barhinge.kinematics.path import RigidOptions, rigid_fold
+from barhinge.kinematics.sensitivity import RigidSensitivity, rigid_sensitivity
 
 __all__ = [
     "DofReport",
     "NodalConstraints",
     "RigidConstraints",
     "RigidOptions",
+    "RigidSensitivity",
     "dof",
     "folded_sample",
     "rigid_fold",
+    "rigid_sensitivity",
     "select_actuators",
     "triangulated_pattern",
 ]

@@ -89,6 +89,11 @@ class RigidOptions:
         is below this (radians).
     energy_max_iter : int
         Newton iterations of that minimisation per step.
+    saddle_shift : bool
+        After leaving a saddle of the energy, keep the multipliers and shift the Lagrangian
+        Hessian past the negative curvature (and wherever the Newton step is not a descent
+        direction) instead of restarting from the spring metric: avoids cycling between
+        saddles (e.g. least-squares Ron Resch sheets); may land on another minimum.
     over_actuated : str
         Actuators whose targets no rigid fold can meet together: ``"least_squares"``
         (default) meets them in least squares (the actuators become stiff springs to their
@@ -106,6 +111,7 @@ class RigidOptions:
     energy_tol: float = 1e-9
     energy_max_iter: int = 40
     over_actuated: str = "least_squares"
+    saddle_shift: bool = False
 
     def __post_init__(self) -> None:
         if self.over_actuated not in ("least_squares", "error"):
@@ -410,9 +416,15 @@ class RigidSolver:
                 mu = 1e-3 * float(K.diagonal().max(initial=1.0))
             Kf = self._Dfree @ (K + mu * eye) @ self._Dfree + self._Dact
             g = J.T @ r + sgn * viol
-            step = spla.splu(Kf.tocsc(), permc_spec="MMD_AT_PLUS_A").solve(
-                np.where(self.free, -g, 0.0)
-            )
+            try:
+                step = spla.splu(Kf.tocsc(), permc_spec="MMD_AT_PLUS_A").solve(
+                    np.where(self.free, -g, 0.0)
+                )
+            except RuntimeError:  # damping lost below round-off: damp more
+                mu *= 10.0
+                if mu > 1e12:
+                    break
+                continue
             step[~self.free] = 0.0
             r2, J2, v2 = residuals(x + step)
             f2 = float(r2 @ r2 + v2 @ v2)
@@ -497,6 +509,9 @@ class RigidSolver:
         delta = 1e-13 / float(W.max(initial=1.0))
         lam = None
         escapes = 0
+        # shift added to the Lagrangian Hessian where the Newton step is not a descent
+        # direction (an indefinite reduced Hessian: the step would head for a saddle)
+        shift, shift0 = 0.0, 1e-2 * float(self.weights.max(initial=1.0))
         e0 = self.energy(rho)
         for _ in range(self.opt.energy_max_iter):
             r, J = rc.evaluate(rho)
@@ -505,6 +520,8 @@ class RigidSolver:
             Hf = sp.diags(W[fi])
             if lam is not None:
                 Hf = Hf + rc.multiplier_hessian(rho, lam)[fi][:, fi]
+                if shift > 0.0:
+                    Hf = Hf + shift * sp.identity(len(fi))
             m = J.shape[0]
             K = sp.bmat([[Hf, Jf.T], [Jf, -delta * sp.identity(m)]], format="csc")
             rhs = np.concatenate([-g[fi], np.zeros(m)])
@@ -522,13 +539,31 @@ class RigidSolver:
                 return rho, False
             dmax = float(np.max(np.abs(d), initial=0.0))
             log.debug("minimize: |d| %.3e, newton %s, E %.6e", dmax, lam is not None, e0)
+            if (
+                self.opt.saddle_shift
+                and lam is not None
+                and dmax > self.opt.energy_tol
+                and float(g[fi] @ d[fi]) >= 0.0
+            ):
+                # not a descent direction: the reduced Hessian is indefinite here; shift it
+                # (Levenberg) instead of converging to the saddle Newton is heading for
+                shift = max(4.0 * shift, shift0)
+                self.energy_iterations += 1
+                continue
             if dmax <= self.opt.energy_tol:
                 # a stationary point; Newton on the KKT conditions also converges to saddles,
                 # so leave along a direction of negative curvature when there is one
                 esc = self._escape_saddle(rho, lam_new, e0) if escapes < 8 else None
                 if esc is None:
                     return rho, True
-                rho, e0, lam, escapes = esc, self.energy(esc), None, escapes + 1
+                # keep the multipliers, with the Hessian shifted past the negative curvature
+                # so that Newton descends away from the saddle instead of back to it
+                rho, curv = esc
+                e0, escapes = self.energy(rho), escapes + 1
+                if self.opt.saddle_shift:
+                    lam, shift = lam_new, max(shift0, -2.0 * curv)
+                else:
+                    lam = None
                 continue
             if dmax > 0.5:
                 d *= 0.5 / dmax
@@ -541,6 +576,8 @@ class RigidSolver:
                     break
                 alpha *= 0.5
             self.energy_iterations += 1
+            if accepted:
+                shift = 0.0 if shift < 1e-6 * shift0 else 0.25 * shift
             if not accepted:
                 if lam is None:
                     return rho, False
@@ -549,11 +586,14 @@ class RigidSolver:
             lam = lam_new
         return rho, False
 
-    def _escape_saddle(self, rho: np.ndarray, lam: np.ndarray, e0: float) -> np.ndarray | None:
+    def _escape_saddle(
+        self, rho: np.ndarray, lam: np.ndarray, e0: float
+    ) -> tuple[np.ndarray, float] | None:
         """A lower-energy state near the stationary state ``rho`` (multipliers ``lam``) along
         the most negative curvature of the Lagrangian on the tangent space of the free
-        creases, or None when that curvature is positive (a minimum) or the tangent space
-        is too large for a dense check (more than ``SADDLE_CHECK_MAX`` free creases)."""
+        creases, with that curvature (per unit of the normalised direction), or None when
+        it is positive (a minimum) or the tangent space is too large for a dense check (more
+        than ``SADDLE_CHECK_MAX`` free creases)."""
         import scipy.linalg as sla
 
         fi = np.flatnonzero(self.free)
@@ -570,7 +610,8 @@ class RigidSolver:
             return None
         v = np.zeros(self.rc.n_var)
         v[fi] = Z @ vecs[:, 0]
-        v /= np.max(np.abs(v))
+        vmax = float(np.max(np.abs(v)))
+        v /= vmax
         for step in (0.1, 0.03, 0.01, 0.003, 1e-3):
             best = None
             for sgn in (1.0, -1.0):
@@ -580,7 +621,7 @@ class RigidSolver:
                         best = trial
             if best is not None:
                 log.debug("minimize: left a saddle (curvature %.3e)", vals[0])
-                return best
+                return best, float(vals[0])
         return None
 
 
@@ -1130,6 +1171,7 @@ def _make_path(
         "energy_iterations": solver.energy_iterations,
         "branch": ("target fold angles" if np.any(cp.fold_angles != 0) else "M/V assignment"),
         "mirrored": bool(solver.mirrored),
+        "least_squares": bool(solver.soft),
         "actuator_misfit_deg": [
             float(np.max(np.abs(np.degrees(r[solver.drive]) - t), initial=0.0))
             for r, t in zip(R, np.degrees(sched[: len(R)]), strict=True)

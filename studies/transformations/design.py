@@ -1,29 +1,90 @@
 """Design from a target global form: the actuator fold angles that bring a sheet to target
-principal curvatures (the inverse of the study's forward map), by scipy.optimize.
+principal curvatures, or to the form of a target surface (the inverse of the study's forward
+map), by scipy.optimize.
 
 Control: the actuators ``bh.dof`` suggests (as many as the DOF of the folded state, so every
 set of their angles is met exactly by a rigid fold), their fold angles the design variables,
 kept on the M/V branch (magnitudes 5-60 deg with the assignment's sign). Forward map: the
 energy-minimising rigid limit (``transform.rigid_limit``) and one quadratic fitted through the
-facet centroids, ``(k1 L, k2 L)`` with ``k1 >= k2``. ``scipy.optimize.least_squares``
-(trust-region reflective) with forward-difference derivatives of the forward map (the
-rigid-limit solver does not expose parameter sensitivities yet).
+facet centroids, ``(k1 L, k2 L)`` with ``k1 >= k2``. A target surface ``z = f(x, y)`` is
+reduced to the same descriptor: the quadratic fitted through its points above the flat
+sheet's facet centroids (the form up to a rigid motion).
+
+``scipy.optimize.least_squares`` (trust-region reflective) with the exact derivatives of the
+rigid limit (``bh.rigid_sensitivity``: implicit-function theorem on its KKT system, then the
+fit differentiated along each coordinate derivative) or, for comparison, forward differences
+(``jac="fd"``: one more rigid fold per actuator and iteration).
 """
 
 from __future__ import annotations
 
+import time
+from collections.abc import Callable
+
 import numpy as np
 import transform as T
 
+#: target surfaces ``z = f(x, y; kx, ky)`` (x, y from the sheet's centre; kx, ky 1/length)
+SURFACES: dict[str, Callable[..., np.ndarray]] = {
+    "paraboloid": lambda x, y, kx, ky: 0.5 * (kx * x * x + ky * y * y),
+    # spherical cap of curvature kx (ky unused): not a quadratic, fitted like the sheet
+    "cap": lambda x, y, kx, ky: np.sign(kx) * (1 / abs(kx) - np.sqrt(1 / kx**2 - x * x - y * y)),
+}
 
-def principal_curvatures(cp, edges: np.ndarray, angles_deg: np.ndarray, steps: int) -> np.ndarray:
-    """(k1 L, k2 L), k1 >= k2, of the rigid-limit form with ``edges`` at ``angles_deg``."""
+#: reached: both principal curvatures within this fraction of max(|k1 L|, |k2 L|) of target
+TOL = 0.05
+
+
+def _sheet(cp) -> tuple[np.ndarray, float]:
+    V = np.asarray(cp.vertices, float)
+    return V, float(np.ptp(V[:, 0]))
+
+
+def _kL(cp, X: np.ndarray, L: float) -> np.ndarray:
+    from barhinge.analysis.curvature import fit_quadratic, reference_points
+
+    g = fit_quadratic(reference_points(X, cp))
+    return np.array([g.k1 * L, g.k2 * L])
+
+
+def surface_target(cp, surface: str, kx_L: float, ky_L: float) -> np.ndarray:
+    """(k1 L, k2 L) of the quadratic fitted through the target surface ``surface`` above the
+    flat sheet's facet centroids (``kx = kx_L / L``, ``ky = ky_L / L``)."""
+    from barhinge.analysis.curvature import fit_quadratic, reference_points
+
+    V, L = _sheet(cp)
+    P = reference_points(np.column_stack([V[:, :2], np.zeros(len(V))]), cp)
+    x, y = P[:, 0] - P[:, 0].mean(), P[:, 1] - P[:, 1].mean()
+    z = SURFACES[surface](x, y, kx_L / L, ky_L / L)
+    g = fit_quadratic(np.column_stack([x, y, z]))
+    return np.array([g.k1 * L, g.k2 * L])
+
+
+def forward(
+    cp, edges: np.ndarray, angles_deg: np.ndarray, steps: int, jac: bool
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """(k1 L, k2 L) of the rigid-limit form with ``edges`` at ``angles_deg`` and, with
+    ``jac``, its exact derivative (2, n_act) per degree of each actuator."""
     import barhinge as bh
 
+    _, L = _sheet(cp)
     path = T.rigid_limit(cp, bh.Actuators(edges=edges, targets_deg=angles_deg), steps)
-    g = bh.gaussian_curvature(path, pattern=cp).global_fit
-    L = float(np.ptp(np.asarray(cp.vertices, float)[:, 0]))
-    return np.sort([float(g.k1) * L, float(g.k2) * L])[::-1]
+    X = path.X[-1][: cp.n_vertices]
+    k = _kL(cp, X, L)
+    if not jac:
+        return k, None
+    sens = bh.rigid_sensitivity(cp, path, T.rigid_weights(cp))
+    # the fit is an explicit function of X: central differences along each exact dX/dt
+    h = 1e-6 * max(float(np.max(np.abs(sens.dX_dt))), 1e-12) ** -1 * L
+    dk = np.stack(
+        [
+            (_kL(cp, X + h * sens.dX_dt[..., j], L) - _kL(cp, X - h * sens.dX_dt[..., j], L))
+            / (2 * h)
+            for j in range(len(edges))
+        ],
+        axis=1,
+    )
+    return k, dk * (np.pi / 180.0)
 
 
 def _show(v: float) -> str:
@@ -32,52 +93,97 @@ def _show(v: float) -> str:
 
 def design(
     pattern: str,
-    target_k1L: float,
-    target_k2L: float,
+    target_k1L: float | None = None,
+    target_k2L: float | None = None,
+    surface: str | None = None,
+    kx_L: float | None = None,
+    ky_L: float | None = None,
+    jac: str = "exact",
     quick: bool = True,
     steps: int = 4,
-    max_nfev: int = 30,
+    max_nfev: int = 40,
 ) -> dict:
-    """Fold angles of the ``bh.dof`` actuators that reach ``(k1 L, k2 L)``; reached when both
-    are within 5 % of ``max(|k1 L|, |k2 L|)`` of the target."""
+    """Fold angles of the ``bh.dof`` actuators that reach target principal curvatures
+    ``(k1 L, k2 L)``, or those of the target ``surface`` (a name of :data:`SURFACES` with
+    ``kx_L``, ``ky_L``); reached when both are within 5 % of ``max(|k1 L|, |k2 L|)``.
+    ``jac``: ``"exact"`` (``bh.rigid_sensitivity``) or ``"fd"`` (forward differences)."""
     from scipy.optimize import least_squares
 
     import barhinge as bh
 
+    if jac not in ("exact", "fd"):
+        raise ValueError(f"jac must be 'exact' or 'fd', got {jac!r}")
     cp = T.make_pattern(pattern, quick)
     A = np.asarray(bh.dof(cp).mechanism.actuators, dtype=np.int64)
     s = np.where(cp.assignment[A] == "M", -1.0, 1.0)
-    t = np.sort([float(target_k1L), float(target_k2L)])[::-1]
+    if surface is not None:
+        t = surface_target(cp, surface, float(kx_L), float(ky_L))
+    else:
+        t = np.sort([float(target_k1L), float(target_k2L)])[::-1]
     scale = max(float(np.max(np.abs(t))), 1e-3)
     n_eval = [0]
+    seen_K: list[float] = []
+    cache: dict = {}
+
+    def evaluate(m: np.ndarray, want_jac: bool):
+        key = m.tobytes()
+        if key not in cache or (want_jac and cache[key][1] is None):
+            n_eval[0] += 1
+            cache.clear()
+            cache[key] = forward(cp, A, s * m, steps, want_jac)
+            k = cache[key][0]
+            seen_K.append(float(k[0] * k[1]))
+        return cache[key]
 
     def residual(m: np.ndarray) -> np.ndarray:
-        n_eval[0] += 1
-        return (principal_curvatures(cp, A, s * m, steps) - t) / scale
+        return (evaluate(m, jac == "exact")[0] - t) / scale
 
+    def jacobian(m: np.ndarray) -> np.ndarray:
+        return evaluate(m, True)[1] * s / scale
+
+    t0 = time.perf_counter()
     sol = least_squares(
-        residual, np.full(len(A), 30.0), bounds=(5.0, 60.0), diff_step=1e-4, max_nfev=max_nfev
+        residual,
+        np.full(len(A), 30.0),
+        jac=jacobian if jac == "exact" else "2-point",
+        bounds=(5.0, 60.0),
+        diff_step=1e-4,
+        max_nfev=max_nfev,
+        xtol=1e-10,
+        ftol=1e-10,
+        gtol=1e-10,
     )
-    k = principal_curvatures(cp, A, s * sol.x, steps)
+    seconds = time.perf_counter() - t0
+    k = evaluate(sol.x, False)[0]
     err = float(np.max(np.abs(k - t)) / scale)
-    if err <= 0.05:
+    reached = err <= TOL
+    if reached:
         reason = None
     elif float(np.max(np.abs(sol.jac))) < 1e-8:
         reason = (
             "the global form does not respond to the actuators: every rigid fold of this "
             f"pattern has (k1 L, k2 L) = ({_show(k[0])}, {_show(k[1])})"
         )
+    elif max(abs(v) for v in seen_K) < 1e-9 * scale**2 and abs(t[0] * t[1]) > 1e-6 * scale**2:
+        reason = (
+            "every rigid fold met has K = 0 (one principal curvature stays 0: a developable "
+            f"global form), the target K L^2 = {_show(float(t[0] * t[1]))}"
+        )
     else:
         reason = "a local minimum of the misfit: the target lies outside the forms reached"
     return {
         "model_label": "rigid limit (energy-minimising)",
         "n_actuators": len(A),
+        "n_vertices": cp.n_vertices,
+        "jac": jac,
         "target": t,
         "achieved": k,
         "relative_error": err,
-        "reached": bool(err <= 0.05),
+        "reached": bool(reached),
         "reason": reason,
         "angles_deg": np.round(s * sol.x, 6),
         "evaluations": n_eval[0],
+        "iterations": int(sol.nfev),
+        "seconds": seconds,
         "optimizer": sol.message,
     }

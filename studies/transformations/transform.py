@@ -37,6 +37,8 @@ PATTERNS: dict[str, tuple[str, str, dict, dict]] = {
 }
 
 CURVES = ("circle", "parabola", "spline")
+#: Newton iterations of the rigid limit's energy minimisation per step
+ENERGY_MAX_ITER = 200
 
 
 def make_pattern(name: str, quick: bool):
@@ -112,7 +114,9 @@ def rigid_limit(cp, acts, steps: int):
     import barhinge as bh
     from barhinge.kinematics.path import RigidOptions
 
-    opts = RigidOptions(check_actuators=False, over_actuated="least_squares")
+    opts = RigidOptions(
+        check_actuators=False, over_actuated="least_squares", energy_max_iter=ENERGY_MAX_ITER
+    )
     return bh.rigid_fold(cp, acts, steps=steps, fold_stiffness=rigid_weights(cp), options=opts)
 
 
@@ -266,7 +270,7 @@ def placement_point(
 
 def cell(kind: str, pattern: str, quick: bool = True, steps: int = 6, **params) -> dict:
     """One run of the study: ``kind`` is ``"form"`` (:func:`point`), ``"placement"``
-    (:func:`placement_point`) or ``"design"`` (``design.design``, on the quick-size sheets)."""
+    (:func:`placement_point`) or ``"design"`` (``design.design``)."""
     if kind == "form":
         return point(pattern, quick=quick, steps=steps, **params)
     if kind == "placement":
@@ -274,5 +278,5 @@ def cell(kind: str, pattern: str, quick: bool = True, steps: int = 6, **params) 
     if kind == "design":
         from design import design
 
-        return design(pattern, quick=True, **params)  # always on the small sheets
+        return design(pattern, quick=quick, **params)
     raise ValueError(f"kind must be 'form', 'placement' or 'design', got {kind!r}")

@@ -97,11 +97,11 @@ def test_bar_and_hinge_converges_to_the_rigid_limit_as_one_over_r(run_mod) -> No
         _check(rig, _published(_form(pattern, kl)))
         assert rig["actuator_misfit_deg"] < 1e-6
         d = []
-        for r in (10.0, 100.0):
+        for r in (100.0, 1000.0):
             bh = _recompute(transform, _form(pattern, kl, r))
             _check(bh, _published(_form(pattern, kl, r)))
             d.append(np.max(np.abs(np.asarray(bh["rho_deg"]) - rig["rho_deg"])))
-        assert mod.slope([10.0, 100.0], d) == pytest.approx(-1.0, abs=tol)
+        assert mod.slope([100.0, 1000.0], d) == pytest.approx(-1.0, abs=tol)
 
 
 def test_rigid_miura_stays_flat_and_bends_into_a_saddle_only_by_straining(run_mod) -> None:
@@ -112,7 +112,7 @@ def test_rigid_miura_stays_flat_and_bends_into_a_saddle_only_by_straining(run_mo
     rig = _recompute(transform, _form("miura", 1.0))
     _check(rig, _published(_form("miura", 1.0)))
     assert rig["actuator_misfit_deg"] > 1.0 and abs(rig["KL2"]) < 1e-9
-    for r in (10.0, 100.0):  # published only (6 s each)
+    for r in (100.0, 1000.0):  # published only (6 s each)
         assert _published(_form("miura", 1.0, r))["KL2"] < -0.01
     for kx, ky in ((1.0, 1.0), (1.0, -1.0)):  # no control surface makes a rigid Miura curve
         assert abs(_published(_form("miura", kx, "rigid", "parabola", ky))["KL2"]) < 1e-9
