@@ -288,16 +288,12 @@ def poisson_check(levels_bh: list[int], levels_shell: list[int]) -> dict:
 
 
 def extrapolate(k: list[float]) -> tuple[float, float, float]:
-    """(reference, observed rate p in h, uncertainty) from values on levels h, h/2, h/4...:
-    Richardson with ``p = log2(d1 / d2)`` of the last two differences when they shrink
-    monotonically; otherwise the finest value, with the last change as its uncertainty."""
-    if len(k) >= 3:
-        d1, d2 = k[-2] - k[-3], k[-1] - k[-2]
-        if d1 * d2 > 0 and abs(d2) < abs(d1):
-            p = math.log2(d1 / d2)
-            corr = d2 / (2.0**p - 1.0)
-            return k[-1] + corr, p, abs(corr)
-    return k[-1], float("nan"), abs(k[-1] - k[-2]) if len(k) > 1 else float("nan")
+    """(reference, observed rate p in h, uncertainty) from values on levels h, h/2, h/4...
+    (:func:`barhinge.analysis.accuracy.richardson`; one level: uncertainty NaN)."""
+    from barhinge.analysis.accuracy import richardson
+
+    ref, p, unc = richardson(list(k))
+    return ref, p, unc if len(k) > 1 else float("nan")
 
 
 def refined_until(rows: list[dict], tol: float = 0.02) -> dict:
