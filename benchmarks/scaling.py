@@ -18,13 +18,28 @@ the iterations per step of the largest size run in full.
 
 ``--publish`` writes the tables into docs/solver-performance.md (between the ``scaling``
 markers), using :func:`barhinge._publish.write_between`.
+
+``--materials`` chooses the stiffness sets (``quasi-rigid``, ``compliant``: the sets of
+``bench_solver.miura_scene``); ``--compliant-sizes`` the sizes of the compliant set (it is
+slower). Per row also: Newton iterations per step, seconds per iteration, the *floor* (one
+numeric refactorisation per step: ``steps`` x the median of three bare refactorisations of
+the last tangent, ``bench_solver.bare_factorisation``), the fold's wall time over that floor,
+the shares of factorisation, assembly and the rest in the solver's own clock, and the whole
+process under ``/usr/bin/time -v`` (wall, user + system CPU, maximum resident set) where that
+program exists.
+
+With ``--pieces`` a paragraph extrapolates a 10 M DOF sheet from the fitted exponents of the
+measured refactorisation time and peak memory (stated as an estimate).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
+import re
 import resource
+import shutil
 import subprocess
 import sys
 import time
@@ -35,35 +50,48 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
+#: the 10 M DOF sheet of the extrapolation paragraph
+TEN_MILLION = 10_000_000
+
 
 def _peak_mb() -> float:
     """Peak resident memory of this process, MB (``ru_maxrss`` is in KB on Linux)."""
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
-def one(n: int, steps: int) -> dict:
+def one(n: int, steps: int, material: str) -> dict:
     """Fold the n x n sheet in this process; the figures of one row."""
-    from bench_solver import miura_scene
+    from bench_solver import bare_factorisation, miura_scene
 
     import barhinge as bh
 
     t0 = time.perf_counter()
-    sc = miura_scene(n, 0.0, steps)
+    sc = miura_scene(n, 0.0, steps, material=material)
     build = time.perf_counter() - t0
     c0, t0 = time.process_time(), time.perf_counter()
     path = bh.solve(sc)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     tm = path.meta["timing"]
     its = int(path.meta["newton"]["total_iterations"])
+    nf = int(tm["n_factorizations"])
+    mu = -np.asarray(path.actuator_moments[-1])  # multipliers of the last state
+    refac, _ = bare_factorisation(sc, path.X[-1], mu, path.meta["linear_solver"], repeat=3)
+    clock = tm["assembly"] + tm["factorize"] + tm["solve"] + tm["other"]
+    solver_wall = max(clock, wall)
     return {
         "n": n,
+        "material": material,
         "dof": int(sc.model.n_dof),
         "build": build,
         "wall": wall,
         "cpu": cpu,
         "iterations": its,
-        "factorizations": int(tm["n_factorizations"]),
-        "s_per_fact": wall / max(int(tm["n_factorizations"]), 1),
+        "factorizations": nf,
+        "s_per_iteration": wall / max(its, 1),
+        "refactorisation": refac,
+        "floor": steps * refac,
+        "share_factorize": tm["factorize"] / solver_wall,
+        "share_assembly": tm["assembly"] / solver_wall,
         "peak_mb": _peak_mb(),
         "steps": steps,
     }
@@ -120,93 +148,209 @@ def pieces(n: int) -> dict:
     }
 
 
+def _time_v(stderr: str) -> dict:
+    """Wall s, CPU s (user + system) and maximum resident set MB from ``time -v`` output."""
+
+    def grab(label: str) -> str | None:
+        m = re.search(rf"^\s*{re.escape(label)}: (.+)$", stderr, re.M)
+        return m.group(1).strip() if m else None
+
+    out: dict = {}
+    user, system = grab("User time (seconds)"), grab("System time (seconds)")
+    if user is not None and system is not None:
+        out["process_cpu"] = float(user) + float(system)
+    rss = grab("Maximum resident set size (kbytes)")
+    if rss is not None:
+        out["process_peak_mb"] = float(rss) / 1024.0
+    wall = grab("Elapsed (wall clock) time (h:mm:ss or m:ss)")
+    if wall is not None:
+        secs = 0.0
+        for part in wall.split(":"):
+            secs = 60.0 * secs + float(part)
+        out["process_wall"] = secs
+    return out
+
+
 def _child(args: list[str]) -> dict:
-    out = subprocess.run(
-        [sys.executable, __file__, *args], capture_output=True, text=True, check=True
-    ).stdout
-    return json.loads(out.strip().splitlines()[-1])
+    cmd = [sys.executable, __file__, *args]
+    timer = shutil.which("time") or ("/usr/bin/time" if Path("/usr/bin/time").exists() else None)
+    if timer is not None:
+        cmd = [timer, "-v", *cmd]
+    run = subprocess.run(cmd, capture_output=True, text=True, check=True)
+    row = json.loads(run.stdout.strip().splitlines()[-1])
+    row.update(_time_v(run.stderr) if timer is not None else {})
+    return row
+
+
+def _fit(rows: list[dict], key: str, xkey: str = "dof") -> float:
+    """Least-squares slope of log(key) against log(xkey)."""
+    x = np.log([r[xkey] for r in rows])
+    return float(np.polyfit(x, np.log([r[key] for r in rows]), 1)[0])
+
+
+def _fmt(r: dict, key: str, spec: str) -> str:
+    return format(r[key], spec) if key in r else "–"
+
+
+def fold_table(rows: list[dict], steps: int) -> list[str]:
+    """Markdown rows of the full folds, both stiffness sets."""
+    lines = [
+        f"### Miura n x n folds, flat -> 60 deg in {steps} steps",
+        "| n | stiffness set | DOF | iterations / step | factorisations | floor: one "
+        "refactorisation per step, s | fold wall s | wall / floor | s / iteration | shares: "
+        "factorisation / assembly / rest | fold CPU s | whole process: wall s / CPU s / max "
+        "RSS MB | KB / DOF |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        rest = 1.0 - r["share_factorize"] - r["share_assembly"]
+        lines.append(
+            f"| {r['n']} | {r['material']} | {r['dof']} | {r['iterations'] / r['steps']:.2f} "
+            f"| {r['factorizations']} | {r['floor']:.1f} | {r['wall']:.1f} "
+            f"| {r['wall'] / r['floor']:.2f} | {r['s_per_iteration']:.3f} "
+            f"| {r['share_factorize']:.0%} / {r['share_assembly']:.0%} / {rest:.0%} "
+            f"| {r['cpu']:.1f} | {_fmt(r, 'process_wall', '.1f')} / "
+            f"{_fmt(r, 'process_cpu', '.1f')} / {_fmt(r, 'process_peak_mb', '.0f')} "
+            f"| {1024 * r.get('process_peak_mb', r['peak_mb']) / r['dof']:.1f} |"
+        )
+    return lines
+
+
+def exponent_lines(rows: list[dict]) -> list[str]:
+    """Fitted exponents per stiffness set (at least two sizes)."""
+    out = []
+    for mat in dict.fromkeys(r["material"] for r in rows):
+        sub = [r for r in rows if r["material"] == mat]
+        if len(sub) < 2:
+            continue
+        out.append(
+            f"- {mat}, n = {', '.join(str(r['n']) for r in sub)}: fold wall time ~ "
+            f"DOF^{_fit(sub, 'wall'):.2f}; refactorisation ~ "
+            f"DOF^{_fit(sub, 'refactorisation'):.2f}; "
+            f"iterations per step ~ DOF^{_fit(sub, 'iterations'):.2f}."
+        )
+    return ["", "Fitted exponents (least squares on log-log axes):", "", *out] if out else []
+
+
+def pieces_lines(r: dict, rows: list[dict], steps: int) -> list[str]:
+    """The measured pieces of the large sheet and the extrapolated full fold."""
+    lines = [
+        "",
+        f"### n = {r['n']}: measured pieces ({r['dof']} DOF)",
+        "| piece | s | peak memory after it, MB |",
+        "|---|---|---|",
+        f"| model build | {r['build']:.1f} | {r['mem_build_mb']:.0f} |",
+        f"| first assembly (tangent) | {r['assembly_first']:.1f} | {r['mem_assembly_mb']:.0f} |",
+        f"| later assembly | {r['assembly']:.1f} | |",
+        f"| first factorisation (with ordering) | {r['fact_first']:.1f} | |",
+        f"| refactorisation | {r['fact']:.1f} | {r['peak_mb']:.0f} |",
+        f"| bordered solve | {r['solve']:.2f} | |",
+    ]
+    quasi = [q for q in rows if q["material"] == "quasi-rigid"]
+    if quasi:
+        last = quasi[-1]
+        per_it = r["assembly"] + r["fact"] + r["solve"]
+        est = per_it * last["factorizations"]
+        floor = steps * r["fact"]
+        counts = ", ".join(str(q["factorizations"]) for q in quasi)
+        lines += [
+            "",
+            f"Extrapolated, not measured: a full {steps}-step fold at n = {r['n']} with the "
+            f"{last['factorizations']} factorisations of the n = {last['n']} fold, each costing "
+            f"one assembly + refactorisation + solve as measured here ({per_it:.1f} s), would "
+            f"take about {est / 60:.0f} min; its floor (one refactorisation per step) is "
+            f"{floor / 60:.0f} min. The count grows with the size ({counts} factorisations "
+            f"for n = {', '.join(str(q['n']) for q in quasi)}), so this is a lower estimate.",
+        ]
+    return lines
+
+
+def ten_million_lines(big: dict, rows: list[dict], steps: int) -> list[str]:
+    """Extrapolate refactorisation time and memory to 10 M DOF from the largest measured sizes."""
+    quasi = [q for q in rows if q["material"] == "quasi-rigid"]
+    if not quasi:
+        return []
+    # memory above the libraries' own (the smallest sheet's process) scales with the sheet
+    base = min(q.get("process_peak_mb", q["peak_mb"]) for q in quasi)
+    pts = [(q["dof"], q["refactorisation"], q.get("process_peak_mb", q["peak_mb"])) for q in quasi]
+    pts.append((big["dof"], big["fact"], big["peak_mb"]))
+    pts = sorted(pts)[-2:]  # the two largest sheets
+    (d0, f0, m0), (d1, f1, m1) = pts
+    pf = float(np.log(f1 / f0) / np.log(d1 / d0))
+    pm = float(np.log((m1 - base) / max(m0 - base, 1.0)) / np.log(d1 / d0))
+    scale = TEN_MILLION / d1
+    fact10 = f1 * scale**pf
+    mem10 = base + (m1 - base) * scale**pm
+    cells = int(round(np.sqrt(TEN_MILLION / 24.0), -1))  # N5B8 Miura: about 24 n^2 DOF
+    ram = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**20
+    fits = (
+        f"That fits in this machine's {ram / 1024:.0f} GB"
+        if mem10 < ram
+        else f"That is beyond this machine's {ram / 1024:.0f} GB"
+    )
+    return [
+        "",
+        "### A 10 M DOF sheet (estimate)",
+        "",
+        f"Extrapolated from the two largest sheets measured above ({d0} and {d1} DOF): the "
+        f"refactorisation grows like DOF^{pf:.2f} and the process's peak memory above the "
+        f"libraries' {base:.0f} MB like DOF^{pm:.2f}. A sheet of 10 M DOF (a Miura of about "
+        f"{cells} x {cells} cells) would need about {mem10 / 1024:.0f} GB and "
+        f"{fact10 / 60:.0f} min per refactorisation, so {steps * fact10 / 3600:.1f} h for the "
+        f"floor of a {steps}-step fold on one node of this kind. {fits}; a larger sheet needs "
+        "a node with more memory (MKL PARDISO also factorises out of core), or a distributed "
+        "direct solver (MUMPS or SuperLU_DIST through PETSc, which split the factor over MPI "
+        "ranks), or an iterative solver preconditioned by domain decomposition. The points of a "
+        "study are independent and already run on a Dask cluster (docs/sweeps.md); a single "
+        "10 M DOF "
+        "fold is the case that needs the distributed factorisation.",
+    ]
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--sizes", type=int, nargs="*", default=[10, 20, 40])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--sizes", type=int, nargs="*", default=[10, 20, 40, 70])
+    ap.add_argument("--compliant-sizes", type=int, nargs="*", default=[10, 20, 40])
+    ap.add_argument(
+        "--materials",
+        nargs="*",
+        default=["quasi-rigid", "compliant"],
+        choices=["quasi-rigid", "compliant"],
+    )
     ap.add_argument("--steps", type=int, default=50)
     ap.add_argument("--pieces", type=int, nargs="*", default=[])
     ap.add_argument("--one", type=int, help=argparse.SUPPRESS)
+    ap.add_argument("--material", default="quasi-rigid", help=argparse.SUPPRESS)
     ap.add_argument("--one-pieces", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--publish", action="store_true", help="write into docs/")
     a = ap.parse_args()
     if a.one is not None:
-        print(json.dumps(one(a.one, a.steps)))
+        print(json.dumps(one(a.one, a.steps, a.material)))
         return
     if a.one_pieces is not None:
         print(json.dumps(pieces(a.one_pieces)))
         return
 
-    lines = [
-        f"### Miura n x n folds, flat -> 60 deg in {a.steps} steps (quasi-rigid set)",
-        "| n | DOF | build s | fold wall s | fold CPU s | iterations | factorisations "
-        "| fold wall s / factorisation | peak memory MB | KB / DOF |",
-        "|---|---|---|---|---|---|---|---|---|---|",
-    ]
-    print("\n".join(lines), flush=True)
     rows = []
-    for n in a.sizes:
-        r = _child(["--one", str(n), "--steps", str(a.steps)])
-        rows.append(r)
-        lines.append(
-            f"| {n} | {r['dof']} | {r['build']:.2f} | {r['wall']:.2f} | {r['cpu']:.2f} | "
-            f"{r['iterations']} | {r['factorizations']} | {r['s_per_fact']:.3f} | "
-            f"{r['peak_mb']:.0f} | {1024 * r['peak_mb'] / r['dof']:.1f} |"
-        )
-        print(lines[-1], flush=True)
-    p = None
-    if len(rows) >= 2:
-        dof = np.log([r["dof"] for r in rows])
-        p = float(np.polyfit(dof, np.log([r["wall"] for r in rows]), 1)[0])
-        pf = float(np.polyfit(dof, np.log([r["s_per_fact"] for r in rows]), 1)[0])
-        lines += [
-            "",
-            f"Fitted exponents over n = {', '.join(str(r['n']) for r in rows)}: "
-            f"fold wall time ~ DOF^{p:.2f}; wall time per factorisation ~ DOF^{pf:.2f}.",
-        ]
-        print(lines[-1], flush=True)
+    for mat in a.materials:
+        for n in a.sizes if mat == "quasi-rigid" else a.compliant_sizes:
+            rows.append(_child(["--one", str(n), "--steps", str(a.steps), "--material", mat]))
+            print(fold_table(rows, a.steps)[-1], flush=True)
+    lines = fold_table(rows, a.steps) + exponent_lines(rows)
     for n in a.pieces:
-        r = _child(["--one-pieces", str(n)])
-        last = rows[-1] if rows else None
-        lines += [
-            "",
-            f"### n = {n}: measured pieces ({r['dof']} DOF)",
-            "| piece | s | peak memory after it, MB |",
-            "|---|---|---|",
-            f"| model build | {r['build']:.1f} | {r['mem_build_mb']:.0f} |",
-            f"| first assembly (tangent) | {r['assembly_first']:.1f} | "
-            f"{r['mem_assembly_mb']:.0f} |",
-            f"| later assembly | {r['assembly']:.1f} | |",
-            f"| first factorisation (with ordering) | {r['fact_first']:.1f} | |",
-            f"| refactorisation | {r['fact']:.1f} | {r['peak_mb']:.0f} |",
-            f"| bordered solve | {r['solve']:.2f} | |",
-        ]
-        if last is not None:
-            per_it = r["assembly"] + r["fact"] + r["solve"]
-            est = per_it * last["factorizations"]
-            counts = ", ".join(str(q["factorizations"]) for q in rows)
-            lines += [
-                "",
-                f"Extrapolated, not measured: a full {a.steps}-step fold at n = {n} with the "
-                f"{last['factorizations']} factorisations of the n = {last['n']} fold, each "
-                f"costing one assembly + refactorisation + solve as measured here "
-                f"({per_it:.1f} s), would take about {est / 60:.0f} min. The count grows with "
-                f"the size ({counts} factorisations for n = "
-                f"{', '.join(str(q['n']) for q in rows)}), so this is a lower estimate.",
-            ]
-        print("\n".join(lines[-10:]), flush=True)
+        big = _child(["--one-pieces", str(n)])
+        lines += pieces_lines(big, rows, a.steps) + ten_million_lines(big, rows, a.steps)
+    print("\n".join(lines), flush=True)
     if a.publish:
         from barhinge._publish import generated_stamp, write_between
 
         cmd = "python benchmarks/scaling.py --publish"
-        if a.sizes != [10, 20, 40]:
+        if a.sizes != [10, 20, 40, 70]:
             cmd += " --sizes " + " ".join(map(str, a.sizes))
+        if a.materials != ["quasi-rigid", "compliant"]:
+            cmd += " --materials " + " ".join(a.materials)
+        elif a.compliant_sizes != [10, 20, 40]:
+            cmd += " --compliant-sizes " + " ".join(map(str, a.compliant_sizes))
         if a.pieces:
             cmd += " --pieces " + " ".join(map(str, a.pieces))
         doc = HERE.parent / "docs" / "solver-performance.md"
