@@ -5,14 +5,16 @@ closed forms).
 Prints the median wall time of ``BarHingeModel.from_pattern`` per rule and scheme, the
 ratio to ``"filipov"`` and the number of Morley solves:
 
-    /work/venv/bin/python benchmarks/bench_plate_calibration.py            # 100 x 100 cells
-    /work/venv/bin/python benchmarks/bench_plate_calibration.py --n 50 --fold 40 --repeat 5
+    python benchmarks/bench_plate_calibration.py            # 100 x 100 cells
+    python benchmarks/bench_plate_calibration.py --n 50 --fold 40 --repeat 5
+    python benchmarks/bench_plate_calibration.py --publish  # into docs/calibration.md
 """
 
 from __future__ import annotations
 
 import argparse
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -28,6 +30,7 @@ def main() -> None:
     ap.add_argument("--n", type=int, default=100)
     ap.add_argument("--fold", type=float, default=0.0, help="facet angle (deg)")
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--publish", action="store_true", help="write into docs/calibration.md")
     args = ap.parse_args()
     cp = bh.families.miura(args.n, args.n, a=1.0, b=1.0, alpha=60.0, fold=args.fold)
     mat = bh.Material(E=1e6, nu=0.3, t=0.01)
@@ -39,9 +42,14 @@ def main() -> None:
         return orig(*a, **kw)
 
     model_mod.plate_corner_stiffness = counting
-    print(f"Miura {args.n} x {args.n} cells, {len(cp.faces)} faces, facet angle {args.fold} deg")
-    print("| scheme | rule | median build (s) | / filipov | Morley solves per build |")
-    print("|---|---|---|---|---|")
+    lines = [
+        f"Miura {args.n} x {args.n} cells, {len(cp.faces)} faces, facet angle {args.fold:g} deg; "
+        f"median of {args.repeat} builds.",
+        "",
+        "| scheme | rule | median build (s) | / filipov | Morley solves per build |",
+        "|---|---|---|---|---|",
+    ]
+    print("\n".join(lines), flush=True)
     for scheme in ("N5B8", "N4B5"):
         base = None
         for rule in RULES:
@@ -53,9 +61,18 @@ def main() -> None:
                 ts.append(time.perf_counter() - t0)
             med = float(np.median(ts))
             base = med if base is None else base
-            print(
+            lines.append(
                 f"| {scheme} | {rule} | {med:.2f} | {med / base:.2f} | {solves[0] // args.repeat} |"
             )
+            print(lines[-1], flush=True)
+    if args.publish:
+        from barhinge._publish import generated_stamp, write_between
+
+        doc = Path(__file__).resolve().parents[1] / "docs" / "calibration.md"
+        body = "\n".join([generated_stamp("python benchmarks/bench_plate_calibration.py --publish"),
+                          "", *lines])  # fmt: skip
+        write_between(doc, "<!-- bench_plate_calibration:start -->",
+                      "<!-- bench_plate_calibration:end -->", body)  # fmt: skip
 
 
 if __name__ == "__main__":

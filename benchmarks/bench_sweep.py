@@ -1,6 +1,7 @@
 """Sweep overheads: serial vs a local Dask cluster (2 worker processes), batch sizes.
 
-Run: ``/work/venv/bin/python benchmarks/bench_sweep.py [--repeat 3]``. The point function
+Run: ``python benchmarks/bench_sweep.py [--repeat 3] [--publish]`` (``--publish`` writes
+the table into docs/sweeps.md between the ``bench_sweep`` markers). The point function
 sleeps (no CPU), so the numbers are the sweep machinery's cost. Columns (medians over the
 repeats): wall time of the whole sweep; ``first s`` = time to the first record (for "local":
 cluster start-up plus one batch); ``s/point`` = steady-state interval between records,
@@ -10,6 +11,7 @@ cluster start-up plus one batch); ``s/point`` = steady-state interval between re
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import tempfile
 import time
@@ -51,6 +53,7 @@ def one(n: int, t: float, mode: str, batch: int) -> tuple[float, float, float]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--publish", action="store_true", help="write the table into docs/sweeps.md")
     args = ap.parse_args()
     cases = [
         (40, 0.0, "serial", 1),
@@ -62,16 +65,37 @@ def main() -> None:
         (10, 0.3, "serial", 1),
         (10, 0.3, "local", 1),
     ]
-    head = ("points", "t_point s", "mode", "batch", "wall s", "first s", "s/point", "ideal")
-    print("{:>6} {:>9} {:>7} {:>5} {:>7} {:>7} {:>8} {:>7}".format(*head))
+    rows = [
+        "| points × duration | mode | batch | wall s | first record s | s between records "
+        "| ideal |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for n, t, mode, batch in cases:
         runs = [one(n, t, mode, batch) for _ in range(args.repeat)]
         wall, first, per = (statistics.median(r[k] for r in runs) for k in range(3))
         ideal = t if mode == "serial" else t / 2
-        print(
-            f"{n:>6} {t:>9.2f} {mode:>7} {batch:>5} {wall:>7.2f} {first:>7.2f} "
-            f"{per:>8.4f} {ideal:>7.3f}"
+        label = "local (2 workers)" if mode == "local" else mode
+        rows.append(
+            f"| {n} × {t:g} s | {label} | {batch} | {wall:.2f} | {first:.2f} | {per:.4f} "
+            f"| {ideal:.3f} |"
         )
+        print(rows[-1], flush=True)
+    if args.publish:
+        from barhinge._publish import generated_stamp, write_between
+
+        load = os.getloadavg()[0]
+        body = "\n".join(
+            [
+                generated_stamp("python benchmarks/bench_sweep.py --publish"),
+                "",
+                f"{os.cpu_count()} cores, load average {load:.1f} at the start; points that "
+                f"sleep, medians of {args.repeat}.",
+                "",
+                *rows,
+            ]
+        )
+        write_between(HERE.parent / "docs" / "sweeps.md", "<!-- bench_sweep:start -->",
+                      "<!-- bench_sweep:end -->", body)  # fmt: skip
 
 
 if __name__ == "__main__":
