@@ -154,9 +154,10 @@ class Assembler:
         return state
 
     def force(self, element_vectors: list[np.ndarray]) -> np.ndarray:
-        """(n_dof,) sum of entry-major element vectors ``(3 * nodes, n_el)`` of each group."""
+        """(n_dof,) sum of entry-major element vectors ``(3 * nodes, n_el)`` of each group
+        (the first groups, in order: groups left out contribute nothing)."""
         val = np.concatenate([f.ravel() for f in element_vectors])
-        return np.bincount(self._fdofs, weights=val, minlength=self.n_dof)
+        return np.bincount(self._fdofs[: len(val)], weights=val, minlength=self.n_dof)
 
     def value_buffers(self) -> tuple[np.ndarray, list[np.ndarray]]:
         """A flat value array and its per-group views ``(m (m + 1) / 2, n_el)``: write the

@@ -47,9 +47,10 @@ VARIANTS = {
     "plate": {},
     "kirchhoff": {"bend_calibration": "kirchhoff"},
     "consistent": {"bend_calibration": "kirchhoff"},
+    "coupled": {"bend_calibration": "kirchhoff"},
 }
 #: variants whose bend and flat-line hinges follow barhinge.model.plate_hinges
-CONSISTENT = ("consistent",)
+CONSISTENT = ("consistent", "coupled")
 
 if QUICK:
     ROOFS = [("pleats", 90.0)]
@@ -64,7 +65,12 @@ else:
         ("miura_arc", 60.0),
     ]
     BH_LEVELS, SHELL_LEVELS = [1, 2, 4, 8, 16], [1, 2, 3, 4]
-    LEVELS = {"plate": [1, 2, 4, 8], "kirchhoff": [1, 2, 4, 8], "consistent": BH_LEVELS}
+    LEVELS = {
+        "plate": [1, 2, 4, 8],
+        "kirchhoff": [1, 2, 4, 8],
+        "consistent": BH_LEVELS,
+        "coupled": BH_LEVELS,
+    }
 
 
 def support_sets(cp, flat_xy: np.ndarray, axis: int) -> tuple[np.ndarray, np.ndarray]:
@@ -96,7 +102,7 @@ def bar_hinge(cp, sv, se, m: int, variant: str = "plate", scheme: str = "N5B8") 
     calibration)."""
     import barhinge as bh
     from barhinge.analysis.stiffness import linear_response
-    from barhinge.model.plate_hinges import consistent_hinge_stiffness
+    from barhinge.model.plate_hinges import consistent_hinge_stiffness, coupled_bending
     from barhinge.pattern.subdivide import subdivided
 
     t0 = time.perf_counter()
@@ -105,7 +111,9 @@ def bar_hinge(cp, sv, se, m: int, variant: str = "plate", scheme: str = "N5B8") 
     crease = np.isin(np.asarray(cpm.assignment), ["M", "V"])
     residual = 0.0
     crease_k = crease_stiffness_per_length(model)
-    if variant in CONSISTENT:
+    if variant == "coupled":
+        model = coupled_bending(model)
+    elif variant in CONSISTENT:
         ph = consistent_hinge_stiffness(model)
         model = model.with_(hinge_k=ph.hinge_k)
         residual = float(ph.residual.max(initial=0.0))
