@@ -437,7 +437,10 @@ def coupled_bending(model: BarHingeModel) -> BarHingeModel:
         int(keep.sum()),
         float(residual.max(initial=0.0)),
     )
-    return model.with_(hinge_k=k_new, hinge_pairs=pairs[keep], pair_k=pk[keep])
+    out = model.with_(hinge_k=k_new, hinge_pairs=pairs[keep], pair_k=pk[keep])
+    out.meta["bending_rule"] = "coupled"
+    out.meta["cell_residual"] = float(residual.max(initial=0.0))
+    return out
 
 
 def _angle_signs(
