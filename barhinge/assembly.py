@@ -178,11 +178,14 @@ class Assembler:
     def matrix_packed(self, element_upper: list[np.ndarray] | np.ndarray) -> sp.csr_matrix:
         """(n_dof, n_dof) CSR sum of symmetric element matrices given by their packed upper
         triangles, entry-major ``(m (m + 1) / 2, n_el)`` in ``numpy.triu_indices(m)`` order
-        (a list with one array per group, or the flat array of :meth:`value_buffers`)."""
+        (a list with one array per group, or the flat array of :meth:`value_buffers`; groups
+        left out at the end contribute nothing)."""
         if isinstance(element_upper, np.ndarray):
             vals = element_upper
         else:
             vals = np.concatenate([v.ravel() for v in element_upper])
+        if len(vals) < self._sum.shape[1]:  # groups left out contribute nothing
+            vals = np.concatenate([vals, np.zeros(self._sum.shape[1] - len(vals))])
         upper = self._sum @ vals
         K = sp.csr_matrix(
             (upper[self._gather], self.indices, self.indptr), shape=(self.n_dof, self.n_dof)

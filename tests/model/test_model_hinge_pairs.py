@@ -95,3 +95,12 @@ def test_bad_pairs_are_one_line_errors():
         m.with_(hinge_pairs=np.array([[0, m.n_hinges]]), pair_k=np.ones(1))
     with pytest.raises(ConfigError, match="itself"):
         m.with_(hinge_pairs=np.array([[1, 1]]), pair_k=np.ones(1)).evaluate(m.X0)
+
+
+def test_stiffness_parts_sum_to_the_tangent_with_couplings():
+    from barhinge.analysis.buckling import stiffness_parts
+
+    _, mp, X = _model_with_pairs()
+    Km, Kg = stiffness_parts(mp, X)
+    K = mp.evaluate(X).K
+    assert abs(Km + Kg - K).max() <= 1e-12 * abs(K).max()
