@@ -154,9 +154,10 @@ class Assembler:
         return state
 
     def force(self, element_vectors: list[np.ndarray]) -> np.ndarray:
-        """(n_dof,) sum of entry-major element vectors ``(3 * nodes, n_el)`` of each group."""
+        """(n_dof,) sum of entry-major element vectors ``(3 * nodes, n_el)`` of each group
+        (the first groups, in order: groups left out contribute nothing)."""
         val = np.concatenate([f.ravel() for f in element_vectors])
-        return np.bincount(self._fdofs, weights=val, minlength=self.n_dof)
+        return np.bincount(self._fdofs[: len(val)], weights=val, minlength=self.n_dof)
 
     def value_buffers(self) -> tuple[np.ndarray, list[np.ndarray]]:
         """A flat value array and its per-group views ``(m (m + 1) / 2, n_el)``: write the
@@ -177,11 +178,14 @@ class Assembler:
     def matrix_packed(self, element_upper: list[np.ndarray] | np.ndarray) -> sp.csr_matrix:
         """(n_dof, n_dof) CSR sum of symmetric element matrices given by their packed upper
         triangles, entry-major ``(m (m + 1) / 2, n_el)`` in ``numpy.triu_indices(m)`` order
-        (a list with one array per group, or the flat array of :meth:`value_buffers`)."""
+        (a list with one array per group, or the flat array of :meth:`value_buffers`; groups
+        left out at the end contribute nothing)."""
         if isinstance(element_upper, np.ndarray):
             vals = element_upper
         else:
             vals = np.concatenate([v.ravel() for v in element_upper])
+        if len(vals) < self._sum.shape[1]:  # groups left out contribute nothing
+            vals = np.concatenate([vals, np.zeros(self._sum.shape[1] - len(vals))])
         upper = self._sum @ vals
         K = sp.csr_matrix(
             (upper[self._gather], self.indices, self.indptr), shape=(self.n_dof, self.n_dof)

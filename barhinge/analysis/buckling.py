@@ -104,8 +104,10 @@ def stiffness_parts(model: Any, X: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_ma
     iu, ju = asm.triu[0]
     nb = len(model.bars)
     Km_b = _bar_blocks(dS, np.zeros(nb), d, B)
-    Km = asm.matrix_packed([Km_b[:, iu, ju].T, _hinge_packed(model, X, np.zeros_like(M), Kt)])
     Kg = geometric_stiffness(model, X, S, M)
+    if len(getattr(model, "hinge_pairs", ())):  # couplings: their cross terms are material
+        return (model.evaluate(X).K - Kg).tocsr(), Kg
+    Km = asm.matrix_packed([Km_b[:, iu, ju].T, _hinge_packed(model, X, np.zeros_like(M), Kt)])
     return Km, Kg
 
 
@@ -166,7 +168,10 @@ def linear_buckling(
     dS = dSde * np.einsum("bi,bi->b", d, U[model.bars[:, 1]] - U[model.bars[:, 0]])
     rho, g = _rho_grad(model, X)
     _, Kt, _ = model._hinge_law(rho)
-    dM = Kt * np.einsum("hk,hk->h", g, du[_hinge_dofs(model)])
+    drho = np.einsum("hk,hk->h", g, du[_hinge_dofs(model)])
+    dM = Kt * drho
+    if len(getattr(model, "hinge_pairs", ())):  # the couplings' moments change too
+        dM = dM + model._pair_C @ drho
     Kg = geometric_stiffness(model, X, dS, dM)
     A = sp.csc_matrix(-Kg[free][:, free])
     k = min(int(n_modes), len(free) - 1)

@@ -10,6 +10,7 @@ quads and polygons.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 from functools import cached_property
 from typing import Any
@@ -42,6 +43,7 @@ from barhinge.model.calibrate import (
     fold_stiffness as _fold_stiffness,
 )
 from barhinge.model.continuum import panel_corner_stiffness, plate_corner_stiffness
+from barhinge.model.hinge_pairs import PairLayout, pair_layout, pair_matrix, pair_upper_values
 from barhinge.model.material import Material
 from barhinge.model.topology import build_topology
 from barhinge.model.triangulate import triangulate
@@ -130,6 +132,9 @@ class BarHingeModel:
     fold_law : "linear" | "penetration"
     fold_limits : (rho_min, rho_max) radians of the penetration law
     strain : "green" | "engineering"
+    hinge_pairs : (n_pairs, 2) int, hinges whose angles are coupled (empty by default)
+    pair_k : (n_pairs,) coupling ``c`` of the energy ``c (rho_i - rho_i0) (rho_j - rho_j0)``
+        (moment per radian; :mod:`barhinge.model.hinge_pairs`)
     """
 
     pattern: CreasePattern
@@ -149,6 +154,10 @@ class BarHingeModel:
     fold_limits: tuple[float, float] = (-0.75 * np.pi, 0.75 * np.pi)
     strain: StrainMeasure = "green"
     meta: dict[str, Any] = dataclasses.field(default_factory=dict)
+    hinge_pairs: np.ndarray = dataclasses.field(
+        default_factory=lambda: _ro(np.zeros((0, 2), np.int64))
+    )
+    pair_k: np.ndarray = dataclasses.field(default_factory=lambda: _ro(np.zeros(0)))
 
     # ------------------------------------------------------------------ creation
     @classmethod
@@ -315,15 +324,27 @@ class BarHingeModel:
         for name, val in changes.items():
             if name not in kw:
                 raise ConfigError(f"BarHingeModel has no field {name!r}")
+            if name in ("hinge_pairs", "pair_k"):
+                kw[name] = _ro(np.array(val, dtype=kw[name].dtype))
+                continue
             if isinstance(kw[name], np.ndarray):
                 val = np.array(val, dtype=kw[name].dtype)
                 if val.shape != kw[name].shape:
                     raise ConfigError(f"{name} must have shape {kw[name].shape}, got {val.shape}")
                 val = _ro(val)
             kw[name] = val
+        pairs, pk = kw["hinge_pairs"], kw["pair_k"]
+        if pairs.ndim != 2 or pairs.shape[1] != 2 or pk.shape != (len(pairs),):
+            raise ConfigError(
+                f"hinge_pairs must have shape (n, 2) and pair_k (n,), got {pairs.shape} and "
+                f"{pk.shape}"
+            )
+        if len(pairs) and (pairs.min() < 0 or pairs.max() >= len(kw["hinges"])):
+            raise ConfigError("hinge_pairs refers to a hinge the model does not have")
         new = BarHingeModel(**kw)
         # same connectivity: share the (expensive) scatter maps
-        if "assembler" in self.__dict__ and "bars" not in changes and "hinges" not in changes:
+        same = not {"bars", "hinges", "hinge_pairs"} & set(changes)
+        if "assembler" in self.__dict__ and same:
             if len(new.X0) == len(self.X0):
                 new.__dict__["assembler"] = self.__dict__["assembler"]
         return new
@@ -334,7 +355,9 @@ class BarHingeModel:
             raise ConfigError(f"stiffness ratio = {ratio}; expected > 0")
         k = np.array(self.hinge_k)
         k[self.hinge_kind == "bend"] *= ratio
-        return self.with_(bar_EA=self.bar_EA * ratio, hinge_k=k)
+        both_bend = (self.hinge_kind[self.hinge_pairs] == "bend").all(axis=1)
+        pk = np.where(both_bend, self.pair_k * ratio, self.pair_k)
+        return self.with_(bar_EA=self.bar_EA * ratio, hinge_k=k, pair_k=pk)
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -378,7 +401,22 @@ class BarHingeModel:
     @cached_property
     def assembler(self) -> Assembler:
         """Sparsity pattern and scatter maps (built once)."""
-        return Assembler(self.n_nodes, [self.bars, self.hinges])
+        groups = [self.bars, self.hinges] + [g.nodes for g in self._pair_groups]
+        return Assembler(self.n_nodes, groups)
+
+    @cached_property
+    def _pair_groups(self) -> list[PairLayout]:
+        return pair_layout(np.asarray(self.hinges), np.asarray(self.hinge_pairs))
+
+    @cached_property
+    def _pair_C(self) -> sp.csr_matrix:
+        return pair_matrix(self.n_hinges, np.asarray(self.hinge_pairs), np.asarray(self.pair_k))
+
+    def _pair_moment(self, rho: np.ndarray) -> np.ndarray | None:
+        """(n_hinges,) moments ``C (rho - rho0)`` of the hinge couplings (None without)."""
+        if not len(self.hinge_pairs):
+            return None
+        return self._pair_C @ (rho - self.rest_angle)
 
     # ------------------------------------------------------------------ evaluation
     @cached_property
@@ -388,8 +426,27 @@ class BarHingeModel:
         lo[self._is_fold], hi[self._is_fold] = self.fold_limits_per_hinge
         return _ro(lo), _ro(hi)
 
-    def _hinge_law(self, rho: np.ndarray, sl: slice = slice(None)):
-        """(M, dM/drho, W) of the hinges ``sl`` at the angles ``rho``."""
+    def _hinge_law(
+        self, rho: np.ndarray, sl: slice = slice(None), pair_moment: np.ndarray | None = None
+    ):
+        """(M, dM/drho, W) of the hinges ``sl`` at the angles ``rho``; with hinge couplings
+        the moment includes ``(C d)_i`` and the energy ``d_i (C d)_i / 2`` (each pair's
+        energy split between its hinges). ``pair_moment`` (all hinges) is needed when ``sl``
+        is not every hinge."""
+        M, Kt, W = self._own_hinge_law(rho, sl)
+        if len(self.hinge_pairs):
+            if pair_moment is None:
+                if len(rho) != self.n_hinges:
+                    raise ValueError("hinge couplings need the moments of all hinges")
+                pair_moment = self._pair_moment(rho)
+            assert pair_moment is not None
+            pm = pair_moment[sl]
+            M = M + pm
+            W = W + 0.5 * (rho - self.rest_angle[sl]) * pm
+        return M, Kt, W
+
+    def _own_hinge_law(self, rho: np.ndarray, sl: slice = slice(None)):
+        """(M, dM/drho, W) of the hinges' own springs (no couplings)."""
         M, Kt, W = hinge_linear(rho, self.rest_angle[sl], self.hinge_k[sl])
         if self.fold_law == "penetration":
             f = self._is_fold[sl]
@@ -423,10 +480,15 @@ class BarHingeModel:
         fb = (S[:, None] * d).T  # (3, nb)
         fe_bar = np.concatenate([-fb, fb], axis=0)
         asm = self.assembler
+        law = self._hinge_law
+        if len(self.hinge_pairs):
+            law = functools.partial(law, pair_moment=self._pair_moment(hinge_angle(X, hinges)))
         if tangent:
-            flat, (Kb, Hp) = asm.value_buffers()
+            flat, (Kb, Hp, *Pp) = asm.value_buffers()
             # g (12, nh), Hp (78, nh): packed upper triangle of the hinge energy Hessian
-            rho, M, Kt, Wh, g, _ = hinge_energy_hessian_packed(X, hinges, self._hinge_law, Hp)
+            rho, M, Kt, Wh, g, _ = hinge_energy_hessian_packed(X, hinges, law, Hp)
+            for group, out in zip(self._pair_groups, Pp, strict=True):
+                pair_upper_values(group, g, self.hinge_pairs, self.pair_k, out)
         else:
             rho, g = hinge_angle_gradient_t(X, hinges)
             M, Kt, Wh = self._hinge_law(rho)

@@ -48,7 +48,14 @@ from barhinge.model.model import BarHingeModel
 
 logger = logging.getLogger(__name__)
 
-__all__ = ["PlateHinges", "cell_fit", "consistent_bending", "consistent_hinge_stiffness"]
+__all__ = [
+    "PlateHinges",
+    "cell_fit",
+    "cell_matrix",
+    "consistent_bending",
+    "consistent_hinge_stiffness",
+    "coupled_bending",
+]
 
 #: weight of the pull of each hinge group towards 4/3 D in the cell fit (log scale)
 REGULARISATION = 1e-3
@@ -259,3 +266,205 @@ def consistent_bending(model: BarHingeModel) -> BarHingeModel:
     """The model with the plate-consistent bend and flat-line hinge stiffnesses of
     :func:`consistent_hinge_stiffness`."""
     return model.with_(hinge_k=consistent_hinge_stiffness(model).hinge_k)
+
+
+def cell_matrix(P: np.ndarray, nu: float) -> tuple[np.ndarray, float]:
+    """Energy matrix over D of one flat cell's hinge angles, with couplings (the sheet's nu).
+
+    The cell stores ``theta^T K theta D / 2`` (``theta`` its hinge angles in the order of
+    ``_cell_rows``; a side hinge shared with the neighbour cell counts in both cells). For
+    every uniform curvature ``kappa`` (and the centre offset relaxed) it equals the Kirchhoff
+    plate energy ``area kappa^T P kappa / 2`` with the sheet's ``nu`` and *no* null
+    Lagrangian, so it holds at free and crease-bounded edges too.
+
+    Triangles: three angles and three curvatures, ``K = R^-T (area P) R^-1`` (``R`` the
+    angle rows), the only such form. Quadrilaterals: ``K = alpha K_d + L C L^T`` with ``L``
+    the dual rows (``L^T R = I`` on the
+    curvatures, ``L^T R_delta = 0``) and ``C = area P - alpha cond(K_d)``, where ``K_d`` gives
+    every hinge the square cell's ``4/3`` (no near-rigid hinge, so no locking); ``alpha`` is the
+    largest value that keeps ``C`` positive semi-definite, so ``K`` is positive definite
+    wherever ``K_d`` is (no zero-energy mode beyond the rigid ones).
+
+    Returns
+    -------
+    K : (n, n) float, symmetric positive semi-definite
+    residual : float, largest |entry| of the condensed mismatch / D (round-off when exact)
+    """
+    P = np.asarray(P, float)
+    rows, w, grp = _cell_rows(P)
+    area = 0.5 * abs(float(np.sum(P[:, 0] * np.roll(P[:, 1], -1) - np.roll(P[:, 0], -1) * P[:, 1])))
+    plate = area * np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 2.0 * (1.0 - nu)]])
+    if len(P) == 3:
+        Rinv = np.linalg.inv(rows[:, :3])
+        K = Rinv.T @ plate @ Rinv
+    else:
+        Kd = np.diag(w * (4.0 / 3.0))  # the square cell's hinges, scaled by alpha below
+        Md = _condensed_form(Kd, rows)
+        # largest alpha with plate - alpha Md >= 0: the smallest generalised eigenvalue
+        Lc = np.linalg.cholesky(Md)
+        Li = np.linalg.inv(Lc)
+        alpha = float(np.linalg.eigvalsh(Li @ plate @ Li.T).min())
+        C = plate - alpha * Md
+        ev, V = np.linalg.eigh(0.5 * (C + C.T))
+        C = (V * np.clip(ev, 0.0, None)) @ V.T
+        L = (rows @ np.linalg.inv(rows.T @ rows))[:, :3]
+        K = alpha * Kd + L @ C @ L.T
+    K = 0.5 * (K + K.T)
+    residual = float(np.abs(_condensed_form(K, rows) - plate).max() / area)
+    return K, residual
+
+
+def _condensed_form(K: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """(3, 3) form ``R^T K R`` in (k11, k22, k12), the centre offset (4th row entry, if
+    any) condensed out."""
+    M = rows.T @ K @ rows
+    if M.shape[0] == 4 and M[3, 3] > 1e-300:
+        return M[:3, :3] - np.outer(M[:3, 3], M[3, :3]) / M[3, 3]
+    return M[:3, :3]
+
+
+#: a uniform curvature (k11, k22, k12) that moves every hinge of a cell (sign test)
+_TEST_CURVATURES = np.array([[1.0, 0.6, 0.35], [-0.4, 1.0, 0.8]])
+
+
+def coupled_bending(model: BarHingeModel) -> BarHingeModel:
+    """The model with plate-consistent hinges *and* couplings: every cell stores the
+    Kirchhoff plate energy of every uniform curvature with the sheet's Poisson ratio
+    (:func:`cell_matrix`), the crease springs in series with the plate strip beside them.
+
+    Couplings stay inside cells and never involve a crease hinge: a crease's angle holds its
+    own rotation, which the plate energy must not see. Cells on a crease or a free edge keep
+    the principal part of their matrix (positive semi-definite); their crease hinge gets the
+    cell's diagonal entry as its plate strip. Needs N5B8 quadrilateral or triangular faces on
+    a grid where the neighbour across a side is the cell's point reflection (the grids of
+    ``barhinge.pattern.subdivide.subdivided``); elsewhere a warning names the largest
+    mismatch of the hinge angles against that assumption.
+    """
+    from barhinge.kernels.geometry import hinge_angle_derivatives
+
+    cp = model.pattern
+    if model.scheme != "N5B8":
+        raise ConfigError(f"coupled bending needs an N5B8 model, got {model.scheme}")
+    sizes = np.array([len(f) for f in cp.faces])
+    if not np.isin(sizes, (3, 4)).all():
+        raise ConfigError("coupled bending needs triangular or quadrilateral faces")
+    mat = model.material
+    D, nu = mat.bending_rigidity, mat.nu
+    X = np.asarray(model.X0, float)
+    nv = cp.n_vertices
+    h = np.asarray(model.hinges)
+    bend = np.asarray(model.hinge_kind) == "bend"
+    edge_of = np.asarray(model.hinge_edge)
+    asg = np.asarray(cp.assignment)
+    flat_line = ~bend & (edge_of >= 0)
+    flat_line &= asg[np.maximum(edge_of, 0)] == "F"
+    crease = ~bend & ~flat_line & (edge_of >= 0)
+    hinge_of_edge = np.asarray(model.fold_hinge_of_edge)
+    E = np.asarray(cp.edges, np.int64)
+    ekey = np.minimum(E[:, 0], E[:, 1]) * nv + np.maximum(E[:, 0], E[:, 1])
+    eorder = np.argsort(ekey)
+    hface = np.asarray(model.hinge_face)
+    hkey = np.where(bend, hface * nv + np.minimum(h[:, 0], h[:, 1]), -1)
+    horder = np.argsort(hkey)
+    _, grad, _ = hinge_angle_derivatives(X, h)  # (nh, 12) at the reference
+    diag = np.zeros(model.n_hinges)
+    pair_i, pair_j, pair_c = [], [], []
+    residual = np.zeros(cp.n_faces)
+    worst = 0.0
+    for size in (3, 4):
+        fids = np.flatnonzero(sizes == size)
+        if not len(fids):
+            continue
+        F = np.array([cp.faces[f] for f in fids], np.int64)
+        P2 = _cells_2d(X, F)
+        area = 0.5 * np.abs(
+            np.sum(
+                P2[..., 0] * np.roll(P2[..., 1], -1, 1) - np.roll(P2[..., 0], -1, 1) * P2[..., 1], 1
+            )
+        )
+        key = np.round(P2 / np.sqrt(area)[:, None, None], SHAPE_DIGITS).reshape(len(fids), -1)
+        _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
+        inv = inv.ravel()
+        shapes = [cell_matrix(P2[f], nu) for f in first]
+        K = np.array([s[0] for s in shapes])[inv]  # (nf, n, n) / D
+        residual[fids] = np.array([s[1] for s in shapes])[inv]
+        # angle rows per cell: the representative's, scaled to the cell (rows ~ length)
+        rows = np.array([_cell_rows(P2[f])[0] for f in first])[inv]  # (nf, n, 4)
+        rows = rows * np.sqrt(area / area[first][inv])[:, None, None]
+        # model hinge of every cell hinge: sides, then (quads) the half-diagonals
+        a, b = F, np.roll(F, -1, axis=1)
+        e = eorder[np.searchsorted(ekey, np.minimum(a, b) * nv + np.maximum(a, b), sorter=eorder)]
+        hid = hinge_of_edge[e]  # (nf, size), -1 on boundary edges
+        if size == 4:
+            hk = fids[:, None] * nv + F
+            pos = np.searchsorted(hkey, hk, sorter=horder)
+            dg = horder[np.minimum(pos, len(h) - 1)]
+            if not np.array_equal(hkey[dg], hk):
+                raise ConfigError("N5B8 model and pattern disagree on the cells' diagonals")
+            hid = np.concatenate([hid, dg], axis=1)
+        valid = hid >= 0
+        plate_like = valid & ~crease[np.maximum(hid, 0)]
+        sign, mismatch = _angle_signs(X, F, h, grad, np.where(plate_like, hid, -1), rows)
+        worst = max(worst, mismatch)
+        # diagonal entries: every valid hinge (creases: their plate strip)
+        np.add.at(diag, hid[valid], D * np.einsum("fii->fi", K)[valid])
+        n = hid.shape[1]
+        ia, ib = np.triu_indices(n, 1)
+        ok = plate_like[:, ia] & plate_like[:, ib]
+        c = D * K[:, ia, ib] * sign[:, ia] * sign[:, ib]
+        pair_i.append(hid[:, ia][ok])
+        pair_j.append(hid[:, ib][ok])
+        pair_c.append(c[ok])
+    if worst > 1e-6:
+        logger.warning(
+            "coupled bending: hinge angles differ from the point-reflection grid by up to "
+            "%.2g (relative); those cells do not pass the patch test exactly",
+            worst,
+        )
+    k_new = np.array(model.hinge_k, float)
+    k_new[bend | flat_line] = diag[bend | flat_line]
+    ks, kc = diag[crease], k_new[crease]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k_new[crease] = np.where((ks > 0) & (kc > 0), kc * ks / (kc + ks), kc)
+    pi, pj = np.concatenate(pair_i), np.concatenate(pair_j)
+    lo, hi = np.minimum(pi, pj), np.maximum(pi, pj)
+    keys, where = np.unique(lo * model.n_hinges + hi, return_inverse=True)
+    pk = np.bincount(where.ravel(), weights=np.concatenate(pair_c), minlength=len(keys))
+    pairs = np.stack([keys // model.n_hinges, keys % model.n_hinges], axis=1)
+    keep = np.abs(pk) > 1e-14 * D
+    logger.debug(
+        "coupled bending: %d pairs, largest cell residual %.2g",
+        int(keep.sum()),
+        float(residual.max(initial=0.0)),
+    )
+    out = model.with_(hinge_k=k_new, hinge_pairs=pairs[keep], pair_k=pk[keep])
+    out.meta["bending_rule"] = "coupled"
+    out.meta["cell_residual"] = float(residual.max(initial=0.0))
+    return out
+
+
+def _angle_signs(
+    X: np.ndarray, F: np.ndarray, h: np.ndarray, grad: np.ndarray, hid: np.ndarray, rows
+) -> tuple[np.ndarray, float]:
+    """(nf, n) sign of each model hinge angle against the cell's linearised angle row, and
+    the largest relative mismatch of their magnitudes (0 on point-reflection grids)."""
+    P = X[F]
+    nrm = np.cross(P, np.roll(P, -1, axis=1)).sum(axis=1)
+    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+    e1 = P[:, 1] - P[:, 0]
+    e1 /= np.linalg.norm(e1, axis=1)[:, None]
+    e2 = np.cross(nrm, e1)
+    H = h[np.maximum(hid, 0)]  # (nf, n, 4) nodes
+    R = X[H] - P[:, None, None, 0]  # (nf, n, 4, 3)
+    x = np.einsum("fhpk,fk->fhp", R, e1)
+    y = np.einsum("fhpk,fk->fhp", R, e2)
+    coef = np.stack([x * x / 2, y * y / 2, x * y], axis=-1)  # (nf, n, 4, 3)
+    g = grad[np.maximum(hid, 0)].reshape(*hid.shape, 4, 3)
+    gn = np.einsum("fhpk,fk->fhp", g, nrm)  # angle per unit normal displacement of a node
+    model_d = np.einsum("fhp,fhpc,tc->tfh", gn, coef, _TEST_CURVATURES)
+    row_d = np.einsum("fhc,tc->tfh", rows[..., :3], _TEST_CURVATURES)
+    best = np.argmax(np.abs(row_d), axis=0)  # the test curvature that moves each hinge most
+    md = np.take_along_axis(model_d, best[None], 0)[0]
+    rd = np.take_along_axis(row_d, best[None], 0)[0]
+    ratio = np.where(hid >= 0, md / rd, 1.0)
+    return np.sign(ratio), float(np.abs(np.abs(ratio) - 1.0).max(initial=0.0))

@@ -1,0 +1,132 @@
+"""The coupled plate-consistent rule (barhinge.model.plate_hinges.coupled_bending).
+
+References:
+* the Kirchhoff plate energy of a uniform curvature, ``D/2 (k11^2 + k22^2 + 2 nu k11 k22 +
+  2 (1 - nu) k12^2)`` per unit area, for every cell shape (the patch test of plate elements:
+  Morley 1968; Irons & Razzaque 1972);
+* Navier's series for the simply supported square plate (Timoshenko & Woinowsky-Krieger 1959,
+  Sec. 30);
+* the scikit-fem facet shell (barhinge.model.shell, Morley plate triangles) of a square plate
+  free on two opposite edges, with the sheet's nu and with nu = 0: an independent model, the
+  only one available where the Poisson ratio matters (free edges).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import barhinge as bh
+from barhinge.analysis.stiffness import linear_response
+from barhinge.model.plate_hinges import cell_matrix, consistent_bending, coupled_bending
+from barhinge.model.shell import shell_model
+from barhinge.pattern.crease import CreasePattern
+from barhinge.pattern.subdivide import subdivided
+
+Q = 1000.0
+SQUARE = CreasePattern(
+    np.array([[0, 0], [1, 0], [1, 1], [0, 1]], float),
+    [[0, 1], [1, 2], [2, 3], [3, 0]],
+    ["B"] * 4,
+    faces=[[0, 1, 2, 3]],
+)
+CELLS = {
+    "square": [[0, 0], [1, 0], [1, 1], [0, 1]],
+    "rectangle 2:1": [[0, 0], [2, 0], [2, 1], [0, 1]],
+    "rhombus 60": [[0, 0], [1, 0], [1.5, np.sqrt(3) / 2], [0.5, np.sqrt(3) / 2]],
+    "skew parallelogram": [[0, 0], [1, 0], [1.3, 0.4], [0.3, 0.4]],
+    "equilateral": [[0, 0], [1, 0], [0.5, np.sqrt(3) / 2]],
+    "right isosceles": [[0, 0], [1, 0], [0, 1]],
+    "obtuse": [[0, 0], [1, 0], [1.4, 0.3]],
+}
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.33, 0.45])
+@pytest.mark.parametrize("name", list(CELLS))
+def test_every_cell_stores_the_plate_energy_of_every_uniform_curvature(name, nu):
+    from barhinge.model.plate_hinges import _cell_rows
+
+    P = np.array(CELLS[name], float)
+    K, residual = cell_matrix(P, nu)
+    rows = _cell_rows(P)[0]
+    area = 0.5 * abs(float(np.sum(P[:, 0] * np.roll(P[:, 1], -1) - np.roll(P[:, 0], -1) * P[:, 1])))
+    rng = np.random.default_rng(1)
+    for kappa in rng.standard_normal((5, 3)):
+        k11, k22, k12 = kappa
+        plate = 0.5 * area * (k11**2 + k22**2 + 2 * nu * k11 * k22 + 2 * (1 - nu) * k12**2)
+        theta = rows[:, :3] @ kappa
+        if rows.shape[1] == 4 and len(P) == 4:  # the centre offset relaxes (minimum over it)
+            d = rows[:, 3]
+            delta = -(d @ K @ theta) / (d @ K @ d)
+            theta = theta + delta * d
+        assert 0.5 * theta @ K @ theta == pytest.approx(plate, rel=1e-9)
+    assert residual < 1e-9
+    eig = np.linalg.eigvalsh(K)
+    assert eig.min() > 1e-3 * eig.max()  # positive definite: no zero-energy angle pattern
+
+
+def _navier(D: float) -> float:
+    k = np.arange(1, 200, 2, dtype=float)
+    M, N = np.meshgrid(k, k)
+    terms = 1.0 / (M * N * (M**2 + N**2) ** 2) * (2 / (M * np.pi)) * (2 / (N * np.pi))
+    return Q / (16 * Q / (np.pi**6 * D) * float(terms.sum()))
+
+
+def _stiffness(model, S) -> float:
+    F = np.zeros((model.n_nodes, 3))
+    for f in model.pattern.faces:
+        X = np.asarray(model.pattern.vertices3d)[list(f)]
+        F[list(f), 2] -= Q * 0.5 * abs(float(np.cross(X, np.roll(X, -1, 0)).sum(0)[2])) / len(f)
+    U, R = linear_response(model, F, S)
+    assert abs(R.sum() + F.sum()) < 1e-8 * abs(F.sum())
+    return float(F[:, 2].sum() ** 2 / np.sum(F * U))
+
+
+def test_simply_supported_plate_converges_to_navier_at_order_two():
+    mat = bh.Material(E=70e9, nu=0.33, t=2e-3)
+    levels, err = [4, 8, 16], []
+    for m in levels:
+        cpm, parent = subdivided(SQUARE, m)
+        model = coupled_bending(bh.BarHingeModel.from_pattern(cpm, "N5B8", mat))
+        S = np.zeros((model.n_nodes, 3), bool)
+        S[np.union1d(np.arange(4), np.flatnonzero(parent >= 0))] = True
+        err.append(abs(_stiffness(model, S) / _navier(mat.bending_rigidity) - 1.0))
+    rate = -np.polyfit(np.log(levels), np.log(err), 1)[0]
+    assert rate == pytest.approx(2.0, abs=0.3)
+    assert err[-1] < 2e-3
+
+
+def _free_edge(mat, rule, m: int) -> float:
+    cpm, _ = subdivided(SQUARE, m)
+    model = rule(bh.BarHingeModel.from_pattern(cpm, "N5B8", mat, bend_calibration="kirchhoff"))
+    X = np.asarray(model.X0)
+    on = (np.abs(X[:, 0]) < 1e-9) | (np.abs(X[:, 0] - 1.0) < 1e-9)
+    on[cpm.n_vertices :] = False
+    S = np.zeros((model.n_nodes, 3), bool)
+    S[on] = True
+    return _stiffness(model, S)
+
+
+def _richardson(k: list[float]) -> float:
+    a, b, c = k[-3:]
+    q = (b - a) / (c - b)
+    return c + (c - b) / (q - 1.0)
+
+
+@pytest.mark.parametrize("nu", [0.33, 0.0])
+def test_plate_free_on_two_edges_converges_to_the_shell_with_the_sheets_nu(nu):
+    # same D for both nu (E adjusted), so only the Poisson ratio differs
+    D, t = 52.4, 2e-3
+    mat = bh.Material(E=D * 12 * (1 - nu**2) / t**3, nu=nu, t=t)
+    shell = []
+    for r in (3, 4, 5):
+        sh = shell_model(SQUARE, mat, r)
+        f = sh.surface_load((0.0, 0.0, -Q))
+        u = sh.solve(f, sh.nodes_on_edges(np.array([1, 3])))
+        shell.append(float(sh.translations(f)[:, 2].sum()) ** 2 / float(f @ u))
+    ref = _richardson(shell)
+    coupled = _richardson([_free_edge(mat, coupled_bending, m) for m in (8, 16, 32)])
+    assert coupled / ref - 1.0 == pytest.approx(0.0, abs=0.01)
+    if nu > 0:  # the uncoupled rule carries nu = -1/3: it misses the sheet's plate
+        plain = _free_edge(mat, consistent_bending, 32)
+        assert abs(plain / ref - 1.0) > 0.015
