@@ -185,6 +185,43 @@ def _cells_2d(X: np.ndarray, F: np.ndarray) -> np.ndarray:
     return np.stack([np.einsum("fki,fi->fk", R, e1), np.einsum("fki,fi->fk", R, e2)], axis=-1)
 
 
+def _cell_groups(cp, X: np.ndarray):
+    """Per face size (3, 4): the face ids, their corners ``F`` (nf, size), the cells in their
+    own planes ``P2`` (nf, size, 2), their areas, and the distinct shapes (``first``: one
+    representative per shape, ``inv``: the shape of every cell), shapes being equal up to
+    translation, rotation and scale."""
+    sizes = np.array([len(f) for f in cp.faces])
+    for size in (3, 4):
+        fids = np.flatnonzero(sizes == size)
+        if not len(fids):
+            continue
+        F = np.array([cp.faces[f] for f in fids], np.int64)
+        P2 = _cells_2d(X, F)
+        area = 0.5 * np.abs(
+            np.sum(
+                P2[..., 0] * np.roll(P2[..., 1], -1, 1) - np.roll(P2[..., 0], -1, 1) * P2[..., 1], 1
+            )
+        )
+        key = np.round(P2 / np.sqrt(area)[:, None, None], SHAPE_DIGITS).reshape(len(fids), -1)
+        _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
+        yield size, fids, F, P2, area, first, inv.ravel()
+
+
+def _diagonal_hinges(model: BarHingeModel, fids: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """(nf, 4) model index of the half-diagonal hinge at every corner of the N5B8 cells."""
+    nv = model.pattern.n_vertices
+    h = np.asarray(model.hinges)
+    bend = np.asarray(model.hinge_kind) == "bend"
+    hkey = np.where(bend, np.asarray(model.hinge_face) * nv + np.minimum(h[:, 0], h[:, 1]), -1)
+    horder = np.argsort(hkey)
+    hk = fids[:, None] * nv + F
+    pos = np.searchsorted(hkey, hk, sorter=horder)
+    hid = horder[np.minimum(pos, len(h) - 1)]
+    if not np.array_equal(hkey[hid], hk):
+        raise ConfigError("N5B8 model and pattern disagree on the cells' diagonals")
+    return hid
+
+
 def consistent_hinge_stiffness(model: BarHingeModel) -> PlateHinges:
     """Plate-consistent stiffnesses of the bend hinges and the ``F``-line fold hinges of an
     N5B8 model of a (subdivided) pattern with triangular or quadrilateral faces (module
@@ -206,41 +243,19 @@ def consistent_hinge_stiffness(model: BarHingeModel) -> PlateHinges:
     eorder = np.argsort(ekey)
     side_k = np.zeros(len(E))  # summed half contributions of the cells on each edge
     residual = np.zeros(cp.n_faces)
-    h = np.asarray(model.hinges)
     bend = np.asarray(model.hinge_kind) == "bend"
-    hface = np.asarray(model.hinge_face)
-    corner = np.minimum(h[:, 0], h[:, 1])
-    hkey = np.where(bend, hface * nv + corner, -1)
-    horder = np.argsort(hkey)
     k_new = np.array(model.hinge_k, float)
-    for size in (3, 4):
-        fids = np.flatnonzero(sizes == size)
-        if not len(fids):
-            continue
-        F = np.array([cp.faces[f] for f in fids], np.int64)
-        P2 = _cells_2d(X, F)
-        area = 0.5 * np.abs(
-            np.sum(
-                P2[..., 0] * np.roll(P2[..., 1], -1, 1) - np.roll(P2[..., 0], -1, 1) * P2[..., 1], 1
-            )
-        )
-        key = np.round(P2 / np.sqrt(area)[:, None, None], SHAPE_DIGITS).reshape(len(fids), -1)
-        _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    for size, fids, F, P2, _, first, inv in _cell_groups(cp, X):
         fits = [cell_fit(P2[f], nu) for f in first]
-        kc = np.array([f[0] for f in fits])[inv.ravel()] * D  # (nf, n hinges of the cell)
-        residual[fids] = np.array([f[2] for f in fits])[inv.ravel()]
+        kc = np.array([f[0] for f in fits])[inv] * D  # (nf, n hinges of the cell)
+        residual[fids] = np.array([f[2] for f in fits])[inv]
         # sides: half of the cell's side stiffness to the edge
         a, b = F, np.roll(F, -1, axis=1)
         sk = np.minimum(a, b) * nv + np.maximum(a, b)
         e = eorder[np.searchsorted(ekey, sk, sorter=eorder)]
         np.add.at(side_k, e.ravel(), 0.5 * kc[:, :size].ravel())
         if size == 4:
-            hk = fids[:, None] * nv + F
-            pos = np.searchsorted(hkey, hk, sorter=horder)
-            hid = horder[np.minimum(pos, len(h) - 1)]
-            if not np.array_equal(hkey[hid], hk):
-                raise ConfigError("N5B8 model and pattern disagree on the cells' diagonals")
-            k_new[hid.ravel()] = kc[:, 4:].ravel()
+            k_new[_diagonal_hinges(model, fids, F).ravel()] = kc[:, 4:].ravel()
     flat_line = ~bend & (np.asarray(model.hinge_edge) >= 0)
     flat_line &= np.asarray(cp.assignment)[np.maximum(model.hinge_edge, 0)] == "F"
     k_new[flat_line] = side_k[np.asarray(model.hinge_edge)[flat_line]]
@@ -363,28 +378,12 @@ def coupled_bending(model: BarHingeModel) -> BarHingeModel:
     E = np.asarray(cp.edges, np.int64)
     ekey = np.minimum(E[:, 0], E[:, 1]) * nv + np.maximum(E[:, 0], E[:, 1])
     eorder = np.argsort(ekey)
-    hface = np.asarray(model.hinge_face)
-    hkey = np.where(bend, hface * nv + np.minimum(h[:, 0], h[:, 1]), -1)
-    horder = np.argsort(hkey)
     _, grad, _ = hinge_angle_derivatives(X, h)  # (nh, 12) at the reference
     diag = np.zeros(model.n_hinges)
     pair_i, pair_j, pair_c = [], [], []
     residual = np.zeros(cp.n_faces)
     worst = 0.0
-    for size in (3, 4):
-        fids = np.flatnonzero(sizes == size)
-        if not len(fids):
-            continue
-        F = np.array([cp.faces[f] for f in fids], np.int64)
-        P2 = _cells_2d(X, F)
-        area = 0.5 * np.abs(
-            np.sum(
-                P2[..., 0] * np.roll(P2[..., 1], -1, 1) - np.roll(P2[..., 0], -1, 1) * P2[..., 1], 1
-            )
-        )
-        key = np.round(P2 / np.sqrt(area)[:, None, None], SHAPE_DIGITS).reshape(len(fids), -1)
-        _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
-        inv = inv.ravel()
+    for size, fids, F, P2, area, first, inv in _cell_groups(cp, X):
         shapes = [cell_matrix(P2[f], nu) for f in first]
         K = np.array([s[0] for s in shapes])[inv]  # (nf, n, n) / D
         residual[fids] = np.array([s[1] for s in shapes])[inv]
@@ -396,12 +395,7 @@ def coupled_bending(model: BarHingeModel) -> BarHingeModel:
         e = eorder[np.searchsorted(ekey, np.minimum(a, b) * nv + np.maximum(a, b), sorter=eorder)]
         hid = hinge_of_edge[e]  # (nf, size), -1 on boundary edges
         if size == 4:
-            hk = fids[:, None] * nv + F
-            pos = np.searchsorted(hkey, hk, sorter=horder)
-            dg = horder[np.minimum(pos, len(h) - 1)]
-            if not np.array_equal(hkey[dg], hk):
-                raise ConfigError("N5B8 model and pattern disagree on the cells' diagonals")
-            hid = np.concatenate([hid, dg], axis=1)
+            hid = np.concatenate([hid, _diagonal_hinges(model, fids, F)], axis=1)
         valid = hid >= 0
         plate_like = valid & ~crease[np.maximum(hid, 0)]
         sign, mismatch = _angle_signs(X, F, h, grad, np.where(plate_like, hid, -1), rows)
