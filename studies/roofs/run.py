@@ -185,6 +185,107 @@ def ranking(top: int = 6) -> str:
     return "\n".join(lines)
 
 
+def _rows(fam: str) -> list[dict]:
+    return sorted((r for r in RESULTS if r["family"] == fam), key=lambda r: r["state"])
+
+
+def _by(fam: str, state: float) -> dict | None:
+    return next((r for r in _rows(fam) if r["state"] == state), None)
+
+
+def findings() -> str:
+    """'What the numbers say' (docs/roofs.md), every number from ``RESULTS``."""
+    kw = {id(r): r["stiffness_per_width"] for r in RESULTS}
+    out = ["What the numbers say:", ""]
+    stiffest = max(RESULTS, key=lambda r: kw[id(r)])
+    lam = stiffest["instability_load_factor"]
+    out.append(
+        "1. **Stiffness is not enough: the ranking above states stability.** Every roof gets "
+        "its linear buckling factor and a nonlinear arc-length path under the design load that "
+        "stops at load factor 1 or at the first limit point; a roof whose tangent loses "
+        "positive definiteness below load factor 1, or whose linear buckling factor is below "
+        f"1, is listed apart. The stiffest roof in linear terms, {stiffest['family']} "
+        f"{stiffest['state']:g} ({kw[id(stiffest)] / 1e3:.1f} kN/m per m), "
+        + (
+            f"becomes unstable at load factor {lam:.3f} on the nonlinear path, so it is not a "
+            "candidate at this thickness."
+            if lam is not None
+            else "carries the design load."
+        )
+        + " Where the linear buckling factor is below 1 but the nonlinear path stays stable "
+        "to 1, the two disagree because the linear estimate ignores the pre-buckling change "
+        "of geometry; both numbers are given, and the roof is listed apart."
+    )
+    miura = [f for f in ("miura60", "miura75") if _rows(f)]
+    if miura:
+        parts = []
+        for f in miura:
+            rs = _rows(f)
+            best = max(rs, key=lambda r: kw[id(r)])
+            lams = [r["buckling_factor"] for r in rs if np.isfinite(r["buckling_factor"])]
+            parts.append(
+                f"{f}: k / width peaks at θ = {best['state']:g}° (mean fold "
+                f"{best['mean_fold_deg']:.0f}°, {kw[id(best)] / 1e3:.1f} kN/m per m), linear "
+                f"buckling factors {min(lams):.3f}–{max(lams):.3f} over the folds"
+            )
+        deep = _rows(miura[0])[-1]
+        out.append(
+            "2. **Miura roofs have an optimum fold**: " + "; ".join(parts) + ". Beyond the "
+            "optimum the section gets deeper but the zig-zag ridges open and the sheet needed "
+            f"grows (sheet / plan area {deep['sheet_area'] / deep['plan_area']:.2f} at θ = "
+            f"{deep['state']:g}°)."
+        )
+    pl = _rows("pleats")
+    if len(pl) >= 2:
+        a, b = pl[0], pl[-1]
+        mono = all(kw[id(q)] > kw[id(p)] for p, q in zip(pl, pl[1:], strict=False))
+        out.append(
+            f"3. **The corrugation stiffens {'monotonically ' if mono else ''}as it closes**: "
+            "k / width × "
+            f"{kw[id(b)] / kw[id(a)]:.0f} from {a['state']:g}° to {b['state']:g}°, k / sheet "
+            f"area × {b['stiffness_per_sheet_area'] / a['stiffness_per_sheet_area']:.0f}, as a "
+            "beam whose depth grows while its width shrinks."
+        )
+    arc = _rows("miura_arc")
+    if len(arc) >= 2:
+        a, b = arc[0], arc[-1]
+        strain = max(r["peak_strain"] for r in arc)
+        out.append(
+            f"4. **The arched Miura** is soft at a small fold (its corrugation runs across the "
+            f"arch, so the arch bends) and stiffens × {kw[id(b)] / kw[id(a)]:.0f} from "
+            f"{a['state']:g}° to {b['state']:g}°; its peak bar strain reaches {strain:.1e}, "
+            "the largest of the study (aluminium's elastic limit is about 3e-3)."
+        )
+    resch, wb = _rows("resch"), _rows("waterbomb")
+    if resch and wb:
+        rk = [kw[id(r)] for r in resch]
+        best = max(wb, key=lambda r: kw[id(r)])
+        out.append(
+            f"5. **Ron Resch and waterbomb textures**: the formed Resch texture has no ridge "
+            f"that spans between the supports ({min(rk) / 1e3:.1f}–{max(rk) / 1e3:.1f} kN/m "
+            "per m over its fold states); the waterbomb is up to "
+            f"× {kw[id(best)] / max(rk):.0f} stiffer, best at s = {best['state']:g}."
+        )
+    flat = _by("flat", 0.0)
+    if flat is not None:
+        softest = min((r for r in RESULTS if r["family"] != "flat"), key=lambda r: kw[id(r)])
+        out.append(
+            f"6. **Folding pays**: the flat sheet has k / width = {kw[id(flat)] / 1e3:.3f} kN/m "
+            f"per m and a linear mean deflection of {flat['mean_deflection_q']:.0f} m under "
+            f"{roofs.Q / 1e3:g} kN/m²: it cannot carry the load. The softest folded roof "
+            f"({softest['family']} {softest['state']:g}) is × {kw[id(softest)] / kw[id(flat)]:.0f}"
+            f" stiffer, the stiffest × {kw[id(stiffest)] / kw[id(flat)]:.0f}."
+        )
+    others = [r["peak_strain"] for r in RESULTS if r["family"] not in ("miura_arc", "flat")]
+    if others:
+        out.append(
+            f"7. Peak bar strains of the other roofs are {min(others):.0e} … {max(others):.0e} "
+            "(bar strains are membrane strains; the sheet's bending surface strains are not "
+            "in the bar-and-hinge model)."
+        )
+    return "\n".join(out)
+
+
 def beam_table() -> str:
     lines = [
         "| fold (deg) | strips per panel | bar-and-hinge k (MN/m) | beam theory k (MN/m) | "
@@ -348,6 +449,8 @@ if MAIN:
         doc = ROOT / "docs" / "roofs.md"
         write_between(doc, "<!-- roofs:start -->", "<!-- roofs:end -->",
                       table() + "\n\n" + ranking())  # fmt: skip
+        write_between(doc, "<!-- roofs-findings:start -->", "<!-- roofs-findings:end -->",
+                      findings())  # fmt: skip
         write_between(doc, "<!-- roofs-beam:start -->", "<!-- roofs-beam:end -->",
                       beam_table() + "\n\n" + beam_notes())  # fmt: skip
         write_between(doc, "<!-- roofs-plate:start -->", "<!-- roofs-plate:end -->",
@@ -356,6 +459,8 @@ if MAIN:
     print(table())
     print()
     print(ranking())
+    print()
+    print(findings())
     print()
     print(beam_table())
     print(beam_notes())
