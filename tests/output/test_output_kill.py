@@ -121,6 +121,10 @@ SIGINT_AT_STEP = """
 import os, signal, sys
 from barhinge.solver import newton
 
+# a shell that starts a job in the background sets SIGINT to "ignore" for it, and Python
+# then leaves it ignored: give the child the handler an interactive terminal's process has
+signal.signal(signal.SIGINT, signal.default_int_handler)
+
 real = newton.solve
 
 
