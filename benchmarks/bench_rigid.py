@@ -1,6 +1,7 @@
 """Time per step of the rigid folding path (bh.rigid_fold) for Miura-ori sheets.
 
 Usage: python benchmarks/bench_rigid.py [--sizes 5 10 20 35 50 70] [--steps 30] [--repeat 1]
+       [--publish]   (writes the table into docs/kinematics.md, ``bench_rigid`` markers)
 
 Each sheet (n x n unit cells of bh.families.miura, i.e. 2n x 2n quad panels) is folded from
 flat to a 120 deg zig-zag fold by one actuator crease in the middle. Printed per size: number
@@ -53,31 +54,43 @@ def main() -> None:
     ap.add_argument("--sizes", type=int, nargs="+", default=[5, 10, 20, 35, 50, 70])
     ap.add_argument("--steps", type=int, default=30)
     ap.add_argument("--repeat", type=int, default=1, help="runs per size (median is kept)")
+    ap.add_argument("--publish", action="store_true", help="write into docs/kinematics.md")
     args = ap.parse_args()
     rows = []
-    hdr = (
-        f"{'cells':>7} {'creases':>8} {'int.vert':>8} {'setup s':>8} {'step1 s':>8} "
-        f"{'median ms/step':>15} {'p90 ms':>8} {'iters':>6} {'max closure':>12}"
-    )
-    print(hdr)
-    print("-" * len(hdr))
+    table = [
+        "| cells (quads) | creases | interior vertices | set-up s | step 1 s | median ms/step "
+        "| p90 ms/step | iterations | max closure residual |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    print("\n".join(table), flush=True)
     for n in args.sizes:
         runs = [run(n, args.steps) for _ in range(args.repeat)]
         r = sorted(runs, key=lambda d: d["median_ms"])[len(runs) // 2]
         rows.append(r)
-        print(
-            f"{r['cells']:>7} {r['creases']:>8d} {r['vertices']:>8d} {r['setup_s']:>8.2f} "
-            f"{r['first_s']:>8.2f} {r['median_ms']:>15.1f} {r['p90_ms']:>8.1f} "
-            f"{r['iters']:>6.1f} {r['closure']:>12.1e}",
-            flush=True,
+        table.append(
+            f"| {n} × {n} ({2 * n} × {2 * n}) | {r['creases']} | {r['vertices']} | "
+            f"{r['setup_s']:.2f} | {r['first_s']:.2f} | {r['median_ms']:.1f} | "
+            f"{r['p90_ms']:.1f} | {r['iters']:.0f} | {r['closure']:.0e} |"
         )
+        print(table[-1], flush=True)
     if len(rows) >= 2:
         x = np.log([r["creases"] for r in rows])
         y = np.log([r["median_ms"] for r in rows])
-        print(
-            f"\nscaling: time per step ~ creases^{np.polyfit(x, y, 1)[0]:.2f} "
-            f"(fit over {len(rows)} sizes)"
-        )
+        table += [
+            "",
+            f"Time per step grows like creases^{np.polyfit(x, y, 1)[0]:.2f} over these sizes "
+            f"({args.steps} steps, median of {args.repeat} run(s) per size).",
+        ]
+        print(table[-1])
+    if args.publish:
+        from pathlib import Path
+
+        from barhinge._publish import generated_stamp, write_between
+
+        doc = Path(__file__).resolve().parents[1] / "docs" / "kinematics.md"
+        body = "\n".join([generated_stamp("python benchmarks/bench_rigid.py --publish"), "",
+                          *table])  # fmt: skip
+        write_between(doc, "<!-- bench_rigid:start -->", "<!-- bench_rigid:end -->", body)
 
 
 if __name__ == "__main__":
