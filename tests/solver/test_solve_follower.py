@@ -65,8 +65,9 @@ def test_work_of_the_turning_load_converges_to_the_stored_energy():
     model, flap, supports = _flap()
     mis = []
     for steps in (10, 20):
-        path = bh.solve(Scene(model, supports=supports, follower=FollowerPressure(3.0, [flap]),
-                              steps=steps, options={"tol_force": 1e-12, "tol_disp": 1e-12}))  # fmt: skip
+        opts = {"tol_force": 1e-12, "tol_disp": 1e-12}
+        fol = FollowerPressure(3.0, [flap])
+        path = bh.solve(Scene(model, supports=supports, follower=fol, steps=steps, options=opts))
         mis.append(path.meta["work_balance"]["rel_mismatch"])
     assert mis[0] < 2e-4 and 6.0 < mis[0] / mis[1] < 10.0
 
@@ -91,8 +92,8 @@ def test_follower_load_stiffness_matches_finite_differences():
 
 def test_scene_toml_follower_pressure_and_its_errors():
     base = {"pattern": {"family": "miura", "params": {"nx": 2, "ny": 2}}, "solve": {"steps": 2}}
-    scene = scene_from_dict({**base, "supports": [{"where": "left"}],
-                             "loads": [{"pressure": 0.5, "follower": True, "faces": [0, 1]}]})  # fmt: skip
+    group = {"pressure": 0.5, "follower": True, "faces": [0, 1]}
+    scene = scene_from_dict({**base, "supports": [{"where": "left"}], "loads": [group]})
     assert scene.follower is not None and scene.follower.p == 0.5 and scene.control == "load"
     bad = [
         ({"loads": [{"pressure": 1.0, "follower": "yes"}]}, "expected true/false"),
