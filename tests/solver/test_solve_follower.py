@@ -48,6 +48,10 @@ def test_follower_pressure_turns_the_flap_linearly():
     np.testing.assert_allclose(rho, lam * p * 0.5 * ARM / (3 * K_FOLD * L), rtol=1e-4, atol=1e-9)
     assert rho[-1] > np.radians(40.0)  # a large rotation: the direction matters
     assert not any("work balance" in ev for ev in path.meta["events"])
+    # the supports carry the turned load: reactions balance it at the final geometry
+    applied = FollowerPressure(p, [flap]).force(model, path.X[-1]).reshape(-1, 3).sum(axis=0)
+    np.testing.assert_allclose(path.reactions[-1].sum(axis=0), -applied, atol=1e-9)
+    assert abs(applied[0]) > 0.1 * np.linalg.norm(applied)  # it has turned away from z
     arc = bh.solve(Scene(model, supports=supports, follower=FollowerPressure(p, [flap]),
                          steps=8, control="arc_length"))  # fmt: skip
     assert arc.load_factor[-1] == pytest.approx(1.0)
