@@ -398,7 +398,7 @@ def _scene_from_dict(d: dict[str, Any], base_dir: Path) -> Scene:
     actuators = None
     if "actuators" in d:
         a = d["actuators"]
-        _check_keys(a, {"edges", "targets_deg", "table_deg"}, "actuators")
+        _check_keys(a, {"edges", "targets_deg", "table_deg", "stiffness"}, "actuators")
         edges = a.get("edges")
         if isinstance(edges, str):
             if edges != "creases":
@@ -407,7 +407,10 @@ def _scene_from_dict(d: dict[str, Any], base_dir: Path) -> Scene:
         if edges is None:
             raise ConfigError("actuators needs edges = [...] or edges = 'creases'")
         actuators = Actuators(
-            edges=edges, targets_deg=a.get("targets_deg"), table_deg=a.get("table_deg")
+            edges=edges,
+            targets_deg=a.get("targets_deg"),
+            table_deg=a.get("table_deg"),
+            stiffness=a.get("stiffness"),
         )
     solve = d.get("solve", {})
     _check_keys(solve, {"steps", "control", "options", "load_case"}, "solve")

@@ -31,11 +31,21 @@ class Actuators:
     table_deg : (n_steps, n_act) float, optional
         Fold angle of each actuator at each step 1..n_steps, degrees: any schedule (e.g.
         creases folding in sequence). Exclusive with ``targets_deg``.
+    stiffness : float or (n_act,) float, optional
+        Compliant actuators: each actuator is a rotational spring of this stiffness (moment
+        per radian, force x length / rad in the user's units; for ``bh.rigid_fold`` in the
+        units of its ``fold_stiffness``) whose far end follows the schedule, so the crease
+        settles where the spring's pull balances the structure: ``rho = target`` only when
+        nothing resists. Default None: held actuators (``rho = target`` exactly, as
+        constraints). Compliant actuators make targets that no fold can meet together a
+        well-posed energy minimum, the same one for the rigid limit and for the bar-and-hinge
+        model (which converges to it as its panels stiffen).
     """
 
     edges: Sequence[int] | np.ndarray
     targets_deg: Sequence[float] | np.ndarray | None = None
     table_deg: np.ndarray | None = None
+    stiffness: float | Sequence[float] | np.ndarray | None = None
 
     def __post_init__(self) -> None:
         e = _check.int_array(self.edges, "actuators.edges", lo=0)
@@ -75,6 +85,26 @@ class Actuators:
                     "expected |angle| < 180"
                 )
             object.__setattr__(self, "table_deg", T)
+        if self.stiffness is not None:
+            k = _check.float_array(self.stiffness, "actuators.stiffness").ravel()
+            if k.size == 1:
+                k = np.full(len(e), float(k[0]))
+            if len(k) != len(e):
+                raise ConfigError(
+                    f"actuators.stiffness has {len(k)} entries, but actuators.edges has {len(e)}"
+                )
+            if np.any(~(k > 0.0)) or np.any(~np.isfinite(k)):
+                bad = int(np.flatnonzero(~(k > 0.0) | ~np.isfinite(k))[0])
+                raise ConfigError(
+                    f"actuators.stiffness = {k[bad]} for edge {e[bad]}; expected a finite "
+                    "value > 0 (omit it for held actuators)"
+                )
+            object.__setattr__(self, "stiffness", k)
+
+    @property
+    def compliant(self) -> bool:
+        """Whether the actuators are springs (``stiffness`` given) rather than held."""
+        return self.stiffness is not None
 
     @property
     def n(self) -> int:

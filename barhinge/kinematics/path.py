@@ -156,6 +156,10 @@ class RigidSolver:
         free[self.act] = False
         self.free = free
         self.soft = False
+        #: (n_act,) stiffness of compliant actuators (moment per radian), None when held
+        self.actuator_k: np.ndarray | None = None
+        #: compliant actuators are held for each step's prediction while that succeeds
+        self.hold_compliant = True
         self.targets_now = np.zeros(len(self.drive))
         #: fold-spring stiffness of each variable (moment per radian) and its rest angle
         self.weights = np.ones(rc.n_var) if weights is None else np.asarray(weights, dtype=float)
@@ -311,10 +315,11 @@ class RigidSolver:
     def tangent(self, rho: np.ndarray, dt: np.ndarray) -> tuple[np.ndarray, float]:
         """Tangent step for actuator increments ``dt``: (rho_pred, relative misfit of the
         linearised constraints, > 0 when the actuators over-determine the motion)."""
-        if self.soft:  # least squares: the actuators move with their targets, then relax
-            out = rho.copy()
-            out[self.drive] += dt
-            return out, 0.0
+        if self.soft and not len(self.act):
+            # released actuators (least squares, compliant): the energy minimisation moves
+            # the state to the new targets from the last one (moving the actuators alone by
+            # dt and projecting back onto the manifold can land on another branch)
+            return rho.copy(), 0.0
         r, J = self.rc.evaluate(rho)
         self._factor(J)
         da = np.zeros(self.rc.n_var)
@@ -464,8 +469,24 @@ class RigidSolver:
         self.underactuated = True
         self._lu = None
 
+    def hold(self, on: bool) -> None:
+        """Hold the driven creases (``on``) or release them: compliant actuators are held
+        for the predictor and corrector of a step (so the step stays on its branch) and
+        released for the energy minimisation."""
+        self.act = self.drive.copy() if on else np.zeros(0, dtype=np.int64)
+        free = np.ones(self.rc.n_var, bool)
+        free[self.act] = False
+        self.free = free
+        self._Dfree = sp.diags(free.astype(float))
+        self._Dact = sp.diags((~free).astype(float))
+        self._lu = None
+
     @property
-    def soft_weight(self) -> float:
+    def soft_weight(self) -> float | np.ndarray:
+        """Stiffness of the actuator springs in least-squares mode: the compliant
+        actuators' own (:attr:`actuator_k`), else 1e6 x the stiffest fold."""
+        if self.actuator_k is not None:
+            return self.actuator_k
         return 1e6 * float(self.weights.max(initial=1.0))
 
     def _springs(self) -> tuple[np.ndarray, np.ndarray]:
@@ -756,6 +777,11 @@ def rigid_fold(
     sched = np.radians(act.schedule(steps, start_deg=np.degrees(rho[av])))
     weights = _spring_weights(rc, fold_stiffness, diagonal_stiffness)
     solver = RigidSolver(rc, av, opt, weights)
+    if act.compliant:
+        # compliant actuators: springs to their targets from the first step (the state is
+        # the least fold-plus-actuator-spring energy on the rigid-folding manifold)
+        solver.actuator_k = np.asarray(act.stiffness, dtype=float)
+        solver.make_soft()
     if rc.holes:
         log.warning(
             "the pattern has %d hole(s): loops of panels around holes are not constrained; "
@@ -944,6 +970,43 @@ def rigid_fold(
     )
 
 
+def _predict(
+    solver: RigidSolver,
+    cur: np.ndarray,
+    a: np.ndarray,
+    b: np.ndarray,
+    s_new: float,
+    flat: bool,
+    opt: RigidOptions,
+    track: list[tuple[float, np.ndarray]],
+    check_misfit: bool,
+) -> tuple[np.ndarray, bool]:
+    """The predicted state for actuators going from ``a`` to ``b`` (the branch rule off a
+    flat state, extrapolation through the last states, or the tangent bent through the
+    state before) and whether the misfit is still to be checked."""
+    guess = None
+    if flat:
+        guess = solver.leave_flat(cur, b)
+    elif not check_misfit:
+        guess = _extrapolate(track, s_new)
+    if guess is None:
+        guess, misfit = solver.tangent(cur, b - a)
+        if misfit > 1e-6 and opt.check_actuators and not solver.soft:
+            raise _Incompatible(
+                f"the actuators over-determine the motion and their targets are "
+                f"incompatible (linearised misfit {misfit:.1e})"
+            )
+        check_misfit = False
+        if len(track) >= 2 and track[-1][0] > track[-2][0]:
+            # Hermite: bend the tangent through the state before (error O(h^3))
+            (s0, r0), (s1, r1) = track[-2], track[-1]
+            h, h0 = s_new - s1, s0 - s1
+            slope = (guess - r1) / h
+            c = (r0 - r1 - slope * h0) / h0**2
+            guess = guess + c * h * h
+    return guess, check_misfit
+
+
 def _advance(
     solver: RigidSolver,
     rho: np.ndarray,
@@ -963,35 +1026,32 @@ def _advance(
     pending = [(t_old, t_new, 0)]
     cur = rho
     over = -1
+    compliant = solver.actuator_k is not None
     while pending:
         a, b, depth = pending.pop()
         solver.targets_now = np.asarray(b, dtype=float).copy()
         s_new = track[-1][0] + float(np.linalg.norm(b - a)) if track else 0.0
         flat = np.max(np.abs(cur), initial=0.0) < FLAT_TOL
-        guess = None
-        if flat:
-            guess = solver.leave_flat(cur, b)
-        elif not check_misfit:
-            guess = _extrapolate(track, s_new)
-        if guess is None:
-            guess, misfit = solver.tangent(cur, b - a)
-            if misfit > 1e-6 and opt.check_actuators and not solver.soft:
-                raise _Incompatible(
-                    f"the actuators over-determine the motion and their targets are "
-                    f"incompatible (linearised misfit {misfit:.1e})"
-                )
-            check_misfit = False
-            if len(track) >= 2 and track[-1][0] > track[-2][0]:
-                # Hermite: bend the tangent through the state before (error O(h^3))
-                (s0, r0), (s1, r1) = track[-2], track[-1]
-                h, h0 = s_new - s1, s0 - s1
-                slope = (guess - r1) / h
-                c = (r0 - r1 - slope * h0) / h0**2
-                guess = guess + c * h * h
-        guess[solver.drive] = b
-        solver.last_guess = guess
-        new, hist, ok = solver.corrector(guess)
-        hist_all.extend(hist)
+        # compliant actuators: predict and correct with them held (the step stays on its
+        # branch), then release them; targets no rigid fold meets together cannot be held,
+        # and from the first such failure on the prediction releases them too
+        held = compliant and solver.hold_compliant
+        for attempt in (True, False) if held else (False,):
+            if compliant:
+                solver.hold(attempt)
+            guess, check_misfit = _predict(solver, cur, a, b, s_new, flat, opt, track, check_misfit)
+            if flat or not solver.soft:
+                # held actuators sit at their targets; released ones (least squares,
+                # compliant) start where they were and the energy minimisation moves them
+                guess[solver.drive] = b
+            solver.last_guess = guess
+            new, hist, ok = solver.corrector(guess)
+            if compliant:
+                solver.hold(False)
+            hist_all.extend(hist)
+            if ok or not attempt:
+                break
+            solver.hold_compliant = False
         if ok and np.max(np.abs(new)) > np.pi:
             ok = False
             over = int(np.argmax(np.abs(new)))
@@ -999,6 +1059,10 @@ def _advance(
             over = -1
         if ok and solver.lands_flat(new, b):
             new = np.zeros_like(new)
+        if ok and solver.soft and np.max(np.abs(new), initial=0.0) < FLAT_TOL and np.any(b):
+            # released actuators pulled towards non-zero targets never rest flat: a landing
+            # there (the flat state closes every loop) is a corrector artefact; cut back
+            ok = False
         if ok and np.max(np.abs(new), initial=0.0) >= FLAT_TOL:
             if solver.underactuated is None:
                 solver.dof_rank = _actuator_rank(solver.rc, new, solver.act)
@@ -1171,7 +1235,11 @@ def _make_path(
         "energy_iterations": solver.energy_iterations,
         "branch": ("target fold angles" if np.any(cp.fold_angles != 0) else "M/V assignment"),
         "mirrored": bool(solver.mirrored),
-        "least_squares": bool(solver.soft),
+        "least_squares": bool(solver.soft and solver.actuator_k is None),
+        "compliant_actuators": solver.actuator_k is not None,
+        "actuator_stiffness": (
+            None if solver.actuator_k is None else [float(k) for k in solver.actuator_k]
+        ),
         "actuator_misfit_deg": [
             float(np.max(np.abs(np.degrees(r[solver.drive]) - t), initial=0.0))
             for r, t in zip(R, np.degrees(sched[: len(R)]), strict=True)

@@ -13,9 +13,10 @@ change of the actuator targets from one linear solve with the exact Lagrangian H
     [H_FF  J_F^T] [drho_F]     [H_FA]
     [J_F   0    ] [dlam  ] = - [J_A ] dt.
 
-Where incompatible targets were met in least squares (``path.meta["least_squares"]``) every
-crease is free and the actuators are springs of stiffness ``w_s`` to their targets: the right
-side is ``[w_s E_A; 0] dt``. Redundant loop equations make ``lam`` non-unique; ``drho`` is
+Where incompatible targets were met in least squares (``path.meta["least_squares"]``) or the
+actuators are compliant (``path.meta["compliant_actuators"]``) every crease is free and the
+actuators are springs of stiffness ``w_s`` to their targets: the right side is
+``[w_s E_A; 0] dt``. Redundant loop equations make ``lam`` non-unique; ``drho`` is
 unique where the reduced Hessian is non-singular (a strict minimum).
 """
 
@@ -85,12 +86,17 @@ def rigid_sensitivity(
     av = rc.var_of_source_edge[np.asarray(path.actuator_edges, dtype=np.int64)]
     t = np.radians(np.asarray(path.actuator_targets_deg[-1], dtype=float))
     W = _spring_weights(rc, fold_stiffness, diagonal_stiffness)
-    soft = bool(path.meta.get("least_squares", False))
+    compliant = bool(path.meta.get("compliant_actuators", False))
+    soft = bool(path.meta.get("least_squares", False)) or compliant
     n, na = rc.n_var, len(av)
     c = rc.rho0.copy()
     w = W.copy()
     if soft:
-        ws = 1e6 * float(W.max(initial=1.0))
+        ws: float | np.ndarray = (
+            np.asarray(path.meta["actuator_stiffness"], dtype=float)
+            if compliant
+            else 1e6 * float(W.max(initial=1.0))
+        )
         c[av] = (w[av] * c[av] + ws * t) / (w[av] + ws)
         w[av] = w[av] + ws
         free = np.ones(n, bool)

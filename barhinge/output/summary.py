@@ -83,6 +83,13 @@ def run_summary(path: FoldPath, scene: Any = None) -> dict[str, Any]:
             "edges": acts.tolist(),
             "angle_deg": path.fold_angles_deg[last][acts].tolist() if len(acts) else [],
             "moment": [_finite(m) for m in moments[last].tolist()],
+            # compliant actuators (springs to their targets) and their stretch, deg
+            "compliant": bool(path.meta.get("compliant_actuators", False)),
+            "misfit_deg": (
+                _finite(path.meta["actuator_misfit_deg"][last])
+                if path.meta.get("actuator_misfit_deg")
+                else None
+            ),
         },
         "timing": path.meta.get("timing", {}),
         # step control per step: Newton iterations, increments, failed increments,
@@ -167,6 +174,9 @@ def summary_rows(summary: dict[str, Any], path: FoldPath | None = None) -> list[
     moments = [abs(m) for m in summary["actuators"]["moment"] if m is not None]
     if moments:
         rows.append(("max |actuator moment|", f"{max(moments):.6g}"))
+    mis = summary["actuators"].get("misfit_deg")
+    if mis is not None and summary["actuators"].get("compliant"):
+        rows.append(("compliant actuators: max |rho - target| (deg)", f"{mis:.4g}"))
     if summary.get("closure_residual") is not None:
         rows.append(("max loop-closure residual", f"{summary['closure_residual']:.2g}"))
     rows += _results_rows(summary.get("results") or {})

@@ -300,16 +300,25 @@ class BorderedSystem:
         mu: np.ndarray,
         penalty: float,
         factorize: bool = False,
+        springs: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> None:
         """Make ``A = K_ff + sum mu_a H_a + p G^T G`` (and G) the current operator.
 
+        ``springs = (m, k)``: the actuators are compliant (no constraint rows); their
+        springs add ``m_a H_a + k_a g_a g_a^T`` (``m = k (rho - target)``) instead.
         Factorises it in direct mode, when ``factorize`` is set, when there is no
         factorisation yet, or when the reuse policy asks for a fresh one. Raises
         SingularMatrixError when a factorisation finds A or the Schur complement singular.
         """
         na = len(mu)
-        if na:
-            g = terms.grad
+        g = terms.grad
+        if springs is not None:
+            m, k = springs
+            na = 0
+            blocks = (
+                m[:, None, None] * terms.hess + k[:, None, None] * g[:, :, None] * g[:, None, :]
+            )
+        elif na:
             blocks = mu[:, None, None] * terms.hess + penalty * g[:, :, None] * g[:, None, :]
         else:
             blocks = np.zeros((0, 12, 12))

@@ -47,7 +47,16 @@ class SolveContext:
         pres = scene.prescribed.ravel()
         self.u_pres = np.where(np.isfinite(pres), pres, 0.0)
         self.hinges = scene.actuator_hinges()
-        self.n_act = len(self.hinges)
+        acts = scene.actuators
+        #: (n_drive,) stiffness of compliant actuators (springs in the residual and tangent,
+        #: force x length / rad), None for held actuators (constraint rows)
+        self.k_act: np.ndarray | None = (
+            np.asarray(acts.stiffness, float) if acts is not None and acts.compliant else None
+        )
+        #: driven creases, held or compliant
+        self.n_drive = len(self.hinges)
+        #: constraint rows of the bordered system: the held actuators
+        self.n_act = 0 if self.k_act is not None else self.n_drive
         self.schedule = np.radians(scene.actuator_schedule_deg())  # (steps+1, n_act)
         self.timer = Timer()
         ext = np.ptp(self.X0, axis=0)
@@ -79,7 +88,7 @@ class SolveContext:
     # ------------------------------------------------------------ schedules
     def targets(self, t: float) -> np.ndarray:
         """Actuator target angles (rad) at path parameter t (linear between rows)."""
-        if not self.n_act:
+        if not self.n_drive:
             return np.zeros(0)
         s = t * self.scene.steps
         i = min(int(np.floor(s)), self.scene.steps - 1)
@@ -101,17 +110,18 @@ class SolveContext:
         terms = actuator_terms(self.model, X, self.hinges)
         self.timer.assembly += time.perf_counter() - t0
         r = np.asarray(ev.force, float).ravel() - st.lam * self.P
-        if self.n_act:
-            r = r + terms.G.T @ st.mu
-        c = terms.rho - self.targets(st.t) if self.n_act else np.zeros(0)
-        if self.n_act:
-            c = (c + np.pi) % (2 * np.pi) - np.pi
+        mu_act = st.mu
+        if self.k_act is not None:  # compliant: spring moments k (rho - target)
+            mu_act = self.k_act * _wrap(terms.rho - self.targets(st.t))
+        if self.n_drive:
+            r = r + terms.G.T @ mu_act
+        c = _wrap(terms.rho - self.targets(st.t)) if self.n_act else np.zeros(0)
         if self.force_floor is None:
             d = np.abs(ev.K.diagonal())
             self.force_floor = 1e-12 * float(d.max() if d.size else 1.0) * self.size
         if self.penalty is None:
             self.penalty = self._auto_penalty(ev.K, terms)
-        return Evaluation(ev, terms, r, c)
+        return Evaluation(ev, terms, r, c, mu_act)
 
     def _auto_penalty(self, K: Any, terms: ActuatorTerms) -> float:
         a = self.opts.augmentation
@@ -133,7 +143,13 @@ class SolveContext:
         preconditioner)."""
         self.system.row_scale = self.c_scale
         check_finite_tangent(e.ev.K)  # NaN / inf never reach the factorisation
-        self.system.set_operator(e.ev.K, e.terms, st.mu, self.penalty or 0.0, factorize=not reuse)
+        springs = None
+        if self.k_act is not None:
+            assert e.mu_act is not None  # set by evaluate
+            springs = (e.mu_act, self.k_act)
+        self.system.set_operator(
+            e.ev.K, e.terms, st.mu, self.penalty or 0.0, factorize=not reuse, springs=springs
+        )
 
     def factorize_or_fail(
         self, e: Evaluation, st: State, res: list[float], reuse: bool = False
@@ -143,3 +159,8 @@ class SolveContext:
             self.factorize(e, st, reuse)
         except SingularMatrixError as exc:
             raise IncrementFailed(f"singular tangent ({exc})", res) from None
+
+
+def _wrap(a: np.ndarray) -> np.ndarray:
+    """Angles (rad) wrapped into [-pi, pi)."""
+    return (a + np.pi) % (2 * np.pi) - np.pi

@@ -29,12 +29,17 @@ class FlatStart:
     def __init__(self, ctx: SolveContext) -> None:
         self.ctx = ctx
         model, scene = ctx.model, ctx.scene
-        self.active = bool(ctx.n_act and ctx.opts.flat_start == "rigid" and is_flat(model))
+        self.active = bool(ctx.n_drive and ctx.opts.flat_start == "rigid" and is_flat(model))
         self.record: dict[str, Any] | None = None
         self._guide: RigidGuide | None = None
         # a folded start: conflicting actuators are named before solving (flat starts: by
         # the rigid predictor)
-        clash = None if self.active else conflicting_actuators(model, scene.actuators, scene.steps)
+        # (compliant actuators may conflict: their springs share the misfit)
+        clash = (
+            None
+            if self.active or ctx.k_act is not None
+            else conflicting_actuators(model, scene.actuators, scene.steps)
+        )
         self.start_events = [clash] if clash else []
         for ev in self.start_events:
             log.warning("%s: %s", scene.name or "solve", ev)
@@ -79,7 +84,7 @@ class FlatStart:
         that fold against their M/V assignment."""
         ctx = self.ctx
         rec = self.record
-        if not records or not (ctx.n_act and is_flat(ctx.model)):
+        if not records or not (ctx.n_drive and is_flat(ctx.model)):
             return list(self.start_events)
         rec = rec or {}
         events = list(rec.get("events", []))

@@ -173,6 +173,8 @@ class _Driver:
             dfull[fixed] = du_c
             rhs = rhs - e.ev.K @ dfull
         c_pred = e.c + (ctx.targets(st.t) - ctx.targets(t1)) if ctx.n_act else e.c
+        if ctx.k_act is not None:  # compliant actuators: their springs' ends move
+            rhs = rhs + e.terms.G.T @ (ctx.k_act * (ctx.targets(t1) - ctx.targets(st.t)))
         ctx.factorize_or_fail(e, st, res, reuse=True)
         dx, dmu = self.system.solve(rhs[free], -c_pred, rtol=1e-6)
         new = State(st.x.copy(), st.mu + dmu, lam1, t1)

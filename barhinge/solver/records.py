@@ -39,7 +39,7 @@ def make_record(
     ev = e.ev
     R = np.zeros(ctx.n_dof)
     R[ctx.fixed] = e.r[ctx.fixed]  # f_int + G^T mu - lam P at supports
-    moments = -st.mu
+    moments = -(st.mu if e.mu_act is None else e.mu_act)
     return StepRecord(
         X=X.copy(),
         fold=np.asarray(ctx.model.crease_fold_angles_deg(X), float),
@@ -106,6 +106,13 @@ def build_path(
         "newton": newton_summary(records, step_stats),
     }
     meta["negative_eigenvalues"] = [r.neg for r in rec]
+    # distance of the actuators from their targets per state, deg (solver tolerance for
+    # held actuators; the springs' stretch for compliant ones)
+    meta["compliant_actuators"] = ctx.k_act is not None
+    meta["actuator_misfit_deg"] = [
+        float(np.max(np.abs((np.degrees(r.rho) - r.targets + 180.0) % 360.0 - 180.0), initial=0.0))
+        for r in rec
+    ]
     events = meta["branch_events"] + stability_events(rec, scene.control)
     meta["work_balance"], unbalanced = work_balance(rec, ctx.floor, ctx.size)
     if unbalanced:

@@ -32,7 +32,10 @@ class Evaluation:
     ev: ModelEvaluation
     terms: ActuatorTerms
     r: np.ndarray  # (n_dof,) f_int - lam P + G^T mu (all DOFs), force
-    c: np.ndarray  # (n_act,) rho - target, rad
+    c: np.ndarray  # (n_act,) rho - target, rad (held actuators; empty for compliant ones)
+    #: (n_drive,) actuator multipliers, force x length: ``mu`` of held actuators, the
+    #: spring moment ``k (rho - target)`` of compliant ones (the actuator moment is minus it)
+    mu_act: np.ndarray | None = None
 
 
 class IncrementFailed(Exception):

@@ -14,6 +14,16 @@ sheet's facet centroids (the form up to a rigid motion).
 rigid limit (``bh.rigid_sensitivity``: implicit-function theorem on its KKT system, then the
 fit differentiated along each coordinate derivative) or, for comparison, forward differences
 (``jac="fd"``: one more rigid fold per actuator and iteration).
+
+``control="surface"`` designs the control instead of the actuator angles: three variables,
+the base fold angle ``beta`` (deg) and the two curvatures ``(kx L, ky L)`` of a control
+surface (``transform._targets`` with a parabola surface; the actuators are the creases of the
+two middle section lines, driven to ``s_i beta + Phi_i(kx, ky)``). The actuators are
+compliant (``transform.COMPLIANT_K``), so every control has one energy-minimising rigid
+form, incompatible targets included. Derivatives by the chain rule: the exact sensitivities
+of the rigid limit to the actuator targets times the derivatives of the targets to the
+control (``s_i`` for beta; central differences of the explicit turning-angle map for the
+curvatures, no rigid fold).
 """
 
 from __future__ import annotations
@@ -60,15 +70,14 @@ def surface_target(cp, surface: str, kx_L: float, ky_L: float) -> np.ndarray:
     return np.array([g.k1 * L, g.k2 * L])
 
 
-def forward(
-    cp, edges: np.ndarray, angles_deg: np.ndarray, steps: int, jac: bool
-) -> tuple[np.ndarray, np.ndarray | None]:
-    """(k1 L, k2 L) of the rigid-limit form with ``edges`` at ``angles_deg`` and, with
-    ``jac``, its exact derivative (2, n_act) per degree of each actuator."""
+def forward(cp, acts, steps: int, jac: bool) -> tuple[np.ndarray, np.ndarray | None]:
+    """(k1 L, k2 L) of the rigid-limit form under the actuators ``acts`` and, with ``jac``,
+    its exact derivative (2, n_act) per degree of each actuator target."""
     import barhinge as bh
 
+    edges = np.asarray(acts.edges)
     _, L = _sheet(cp)
-    path = T.rigid_limit(cp, bh.Actuators(edges=edges, targets_deg=angles_deg), steps)
+    path = T.rigid_limit(cp, acts, steps)
     X = path.X[-1][: cp.n_vertices]
     k = _kL(cp, X, L)
     if not jac:
@@ -87,6 +96,31 @@ def forward(
     return k, dk * (np.pi / 180.0)
 
 
+def forward_control(
+    cp, control: np.ndarray, steps: int, jac: bool
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """(k1 L, k2 L) of the rigid-limit form under the control ``(beta deg, kx L, ky L)``
+    (compliant actuators on a parabola control surface) and, with ``jac``, its derivative
+    (2, 3) by the chain rule."""
+    beta, kx, ky = (float(v) for v in control)
+    acts, _, _ = T._targets(cp, 1, "parabola", kx, ky, base_deg=beta, actuator_k=T.COMPLIANT_K)
+    k, dk_dt = forward(cp, acts, steps, jac)
+    if not jac:
+        return k, None
+    assert dk_dt is not None
+    A = np.asarray(acts.edges)
+    dt = np.zeros((len(A), 3))
+    dt[:, 0] = np.where(cp.assignment[A] == "M", -1.0, 1.0)  # d target / d beta
+    h = 1e-6
+    for j, (dx, dy) in ((1, (h, 0.0)), (2, (0.0, h))):
+        p, _, _ = T._targets(cp, 1, "parabola", kx + dx, ky + dy, base_deg=beta)
+        m, _, _ = T._targets(cp, 1, "parabola", kx - dx, ky - dy, base_deg=beta)
+        if not np.array_equal(p.edges, A) or not np.array_equal(m.edges, A):
+            raise RuntimeError("the control surface's actuators changed under a curvature step")
+        dt[:, j] = (np.asarray(p.targets_deg) - np.asarray(m.targets_deg)) / (2 * h)
+    return k, dk_dt @ dt
+
+
 def _show(v: float) -> str:
     return "0" if abs(v) < 1e-9 else f"{v:.2g}"
 
@@ -101,21 +135,41 @@ def design(
     jac: str = "exact",
     quick: bool = True,
     steps: int = 4,
-    max_nfev: int = 40,
+    max_nfev: int | None = None,
+    control: str = "actuators",
 ) -> dict:
-    """Fold angles of the ``bh.dof`` actuators that reach target principal curvatures
-    ``(k1 L, k2 L)``, or those of the target ``surface`` (a name of :data:`SURFACES` with
-    ``kx_L``, ``ky_L``); reached when both are within 5 % of ``max(|k1 L|, |k2 L|)``.
-    ``jac``: ``"exact"`` (``bh.rigid_sensitivity``) or ``"fd"`` (forward differences)."""
+    """Fold angles of the ``bh.dof`` actuators (``control="actuators"``), or the base fold and
+    control-surface curvatures (``control="surface"``, see the module docstring), that reach
+    target principal curvatures ``(k1 L, k2 L)``, or those of the target ``surface`` (a name
+    of :data:`SURFACES` with ``kx_L``, ``ky_L``); reached when both are within 5 % of
+    ``max(|k1 L|, |k2 L|)``. ``jac``: ``"exact"`` (``bh.rigid_sensitivity``) or ``"fd"``
+    (forward differences). ``max_nfev``: rigid-limit evaluations allowed (default 40 for
+    the actuator angles, 100 for the three control variables, whose misfit is flatter)."""
     from scipy.optimize import least_squares
 
     import barhinge as bh
 
     if jac not in ("exact", "fd"):
         raise ValueError(f"jac must be 'exact' or 'fd', got {jac!r}")
+    if control not in ("actuators", "surface"):
+        raise ValueError(f"control must be 'actuators' or 'surface', got {control!r}")
     cp = T.make_pattern(pattern, quick)
-    A = np.asarray(bh.dof(cp).mechanism.actuators, dtype=np.int64)
-    s = np.where(cp.assignment[A] == "M", -1.0, 1.0)
+    if control == "surface":
+        # variables: beta (deg), kx L, ky L; the map is the control's, the sign is in it
+        A = T._targets(cp, 1, "parabola", 0.0, 0.0)[0].edges
+        s = np.ones(3)
+        x0, bounds = np.array([30.0, 0.0, 0.0]), ([5.0, -3.0, -3.0], [60.0, 3.0, 3.0])
+
+        def fwd(m: np.ndarray, want: bool):
+            return forward_control(cp, m, steps, want)
+    else:
+        A = np.asarray(bh.dof(cp).mechanism.actuators, dtype=np.int64)
+        s = np.where(cp.assignment[A] == "M", -1.0, 1.0)
+        x0, bounds = np.full(len(A), 30.0), (5.0, 60.0)
+
+        def fwd(m: np.ndarray, want: bool):
+            return forward(cp, bh.Actuators(edges=A, targets_deg=s * m), steps, want)
+
     if surface is not None:
         t = surface_target(cp, surface, float(kx_L), float(ky_L))
     else:
@@ -130,7 +184,7 @@ def design(
         if key not in cache or (want_jac and cache[key][1] is None):
             n_eval[0] += 1
             cache.clear()
-            cache[key] = forward(cp, A, s * m, steps, want_jac)
+            cache[key] = fwd(m, want_jac)
             k = cache[key][0]
             seen_K.append(float(k[0] * k[1]))
         return cache[key]
@@ -144,11 +198,11 @@ def design(
     t0 = time.perf_counter()
     sol = least_squares(
         residual,
-        np.full(len(A), 30.0),
+        x0,
         jac=jacobian if jac == "exact" else "2-point",
-        bounds=(5.0, 60.0),
+        bounds=bounds,
         diff_step=1e-4,
-        max_nfev=max_nfev,
+        max_nfev=max_nfev or (40 if control == "actuators" else 100),
         xtol=1e-10,
         ftol=1e-10,
         gtol=1e-10,
@@ -171,8 +225,17 @@ def design(
         )
     else:
         reason = "a local minimum of the misfit: the target lies outside the forms reached"
+    label = "rigid limit (energy-minimising)"
+    if control == "surface":
+        label += f", compliant actuators {T.COMPLIANT_K:g} x stiffest fold"
     return {
-        "model_label": "rigid limit (energy-minimising)",
+        "model_label": label,
+        "control": control,
+        "variables": (
+            {"beta_deg": float(sol.x[0]), "kx_L": float(sol.x[1]), "ky_L": float(sol.x[2])}
+            if control == "surface"
+            else None
+        ),
         "n_actuators": len(A),
         "n_vertices": cp.n_vertices,
         "jac": jac,
@@ -181,7 +244,7 @@ def design(
         "relative_error": err,
         "reached": bool(reached),
         "reason": reason,
-        "angles_deg": np.round(s * sol.x, 6),
+        "angles_deg": np.round(s * sol.x, 6) if control == "actuators" else None,
         "evaluations": n_eval[0],
         "iterations": int(sol.nfev),
         "seconds": seconds,

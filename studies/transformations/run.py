@@ -38,7 +38,7 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(HERE))
-from transform import PATTERNS, make_pattern  # noqa: E402
+from transform import COMPLIANT_K, PATTERNS, make_pattern  # noqa: E402
 
 DOC = ROOT / "docs" / "transformations.md"
 QUICK_JSON = ROOT / "docs" / "transformations-quick.json"
@@ -53,7 +53,12 @@ def _d(pattern, k1=None, k2=None, **kw) -> dict:
     return {"kind": "design", "pattern": pattern, "target_k1L": k1, "target_k2L": k2, **kw}
 
 
-DESIGNS_QUICK = [_d("yoshimura", 0.2, -3.0), _d("miura_arc", 0.0, -0.6), _d("miura", -0.5, -0.5)]
+DESIGNS_QUICK = [
+    _d("yoshimura", 0.2, -3.0),
+    _d("miura_arc", 0.0, -0.6),
+    _d("miura", -0.5, -0.5),
+    _d("yoshimura", 0.2, -2.0, control="surface"),
+]
 DESIGNS = [
     _d("yoshimura", 0.5, -4.0),
     _d("yoshimura", 0.5, -4.0, jac="fd"),
@@ -65,6 +70,12 @@ DESIGNS = [
     _d("miura_arc", -0.5, -0.5),
     _d("miura", -0.5, -0.5),
     _d("russo_pleat", 0.3, -0.3),
+    # control parameters (base fold, control-surface curvatures) as the design variables
+    _d("yoshimura", 0.5, -3.0, control="surface"),
+    _d("yoshimura", 0.5, -3.0, control="surface", jac="fd"),
+    _d("resch", -0.5, -1.5, control="surface"),
+    _d("miura_arc", 0.0, -0.6, control="surface"),
+    _d("miura", -0.5, -0.5, control="surface"),
 ]
 
 
@@ -89,6 +100,10 @@ def settings(quick: bool) -> dict:
             "placement_patterns": ["miura", "yoshimura"],
             "designs": DESIGNS_QUICK,
             "steps": 6,
+            # compliant actuators: the rigid limit and the bar-and-hinge model minimise the
+            # same energy; the springs (100x the folds) need stiffer panels than held cells
+            "compliant_cells": [("miura", 1, 1.0)],
+            "compliant_ratios": [1e4, 1e5],
         }
     kl = [-1.0, 0.0, 0.5, 1.0, 1.5]
     return {
@@ -102,11 +117,15 @@ def settings(quick: bool) -> dict:
         "placement_patterns": pats,
         "designs": DESIGNS,
         "steps": 8,
+        "compliant_cells": [(p, 1, k) for p in pats for k in (0.0, 1.0)],
+        "compliant_ratios": [1e3, 1e4, 1e5],
     }
 
 
-def _form(pattern, spacing=1, curve="circle", kappa_L=0.0, ky_L=None, model="rigid"):
-    return {
+def _form(
+    pattern, spacing=1, curve="circle", kappa_L=0.0, ky_L=None, model="rigid", actuator_k=None
+):
+    out = {
         "kind": "form",
         "pattern": pattern,
         "spacing": spacing,
@@ -115,6 +134,9 @@ def _form(pattern, spacing=1, curve="circle", kappa_L=0.0, ky_L=None, model="rig
         "ky_L": ky_L,
         "model": model,
     }
+    if actuator_k is not None:  # compliant actuators (held ones keep their run keys)
+        out["actuator_k"] = actuator_k
+    return out
 
 
 def placement_counts(pattern: str, quick: bool) -> list[int]:
@@ -131,6 +153,9 @@ def runs(quick: bool) -> list[dict]:
         _form(p, sp, "circle", k) for p in PATTERNS for sp in s["spacings"] for k in s["kappa_L"]
     ]
     pts += [_form(p, sp, "circle", k, model=r) for p, sp, k in s["bh_cells"] for r in s["ratios"]]
+    for p, sp, k in s["compliant_cells"]:
+        for m in ["rigid", *s["compliant_ratios"]]:
+            pts.append(_form(p, sp, "circle", k, model=m, actuator_k=COMPLIANT_K))
     for p in s["curve_patterns"]:
         for c in ("parabola", "spline"):
             pts.append(_form(p, 1, c, 1.0))
@@ -195,12 +220,17 @@ def slope(ratios: list[float], errors: list[float]) -> float:
     return float(np.polyfit(np.log(ratios), np.log(e), 1)[0])
 
 
-def convergence(ix: dict, s: dict) -> list[dict]:
-    """Per bar-and-hinge cell: distance of the fold angles and of K L^2 to the rigid limit."""
+def convergence(ix: dict, s: dict, compliant: bool = False) -> list[dict]:
+    """Per bar-and-hinge cell: distance of the fold angles and of K L^2 to the rigid limit
+    (held actuators, or with ``compliant`` the compliant cells)."""
     rows = []
-    for p, sp, k in s["bh_cells"]:
-        rig = get(ix, pattern=p, spacing=sp, kappa_L=k)
-        bhs = [get(ix, pattern=p, spacing=sp, kappa_L=k, model=r) for r in s["ratios"]]
+    cells, ratios = (
+        (s["compliant_cells"], s["compliant_ratios"]) if compliant else (s["bh_cells"], s["ratios"])
+    )
+    kw = {"actuator_k": COMPLIANT_K} if compliant else {}
+    for p, sp, k in cells:
+        rig = get(ix, pattern=p, spacing=sp, kappa_L=k, **kw)
+        bhs = [get(ix, pattern=p, spacing=sp, kappa_L=k, model=r, **kw) for r in ratios]
         if rig is None or any(b is None for b in bhs):
             rows.append({"pattern": p, "spacing": sp, "kappa_L": k, "ok": False})
             continue
@@ -214,8 +244,9 @@ def convergence(ix: dict, s: dict) -> list[dict]:
                 "misfit_deg": rig["actuator_misfit_deg"],
                 "KL2_rigid": rig["KL2"],
                 "KL2_bh": [b["KL2"] for b in bhs],
+                "misfit_bh": [b["actuator_misfit_deg"] for b in bhs],
                 "drho_deg": d,
-                "slope": slope(s["ratios"], d),
+                "slope": slope(ratios, d),
             }
         )
     return rows
@@ -250,7 +281,16 @@ def headline(records: dict, quick: bool) -> dict:
             continue
         prm = {k: v for k, v in rec["params"].items() if k not in ("quick", "steps")}
         r = rec["result"]
-        keep = ("KL2", "actuator_misfit_deg", "form_error_deg", "model_label", "relative_error")
+        keep = (
+            "KL2",
+            "actuator_misfit_deg",
+            "form_error_deg",
+            "model_label",
+            "relative_error",
+            "reached",
+            "achieved",
+            "variables",
+        )
         out[json.dumps(prm, sort_keys=True)] = {k: r[k] for k in keep if k in r}
     return out
 
@@ -282,8 +322,8 @@ def table_rigid(ix: dict, s: dict) -> str:
     return "\n".join(lines)
 
 
-def table_convergence(rows: list[dict], s: dict) -> str:
-    rs = s["ratios"]
+def table_convergence(rows: list[dict], s: dict, compliant: bool = False) -> str:
+    rs = s["compliant_ratios"] if compliant else s["ratios"]
     head = (
         "| pattern | κL | misfit (deg) | K L² rigid | "
         + " | ".join(f"K L² r = {r:g}" for r in rs)
@@ -380,9 +420,9 @@ def table_placement(rows: list[dict]) -> str:
 
 def table_design(ix: dict, s: dict) -> str:
     lines = [
-        "| pattern | vertices | actuators (bh.dof) | target | target k1 L, k2 L | "
+        "| pattern | vertices | control | actuators | target | target k1 L, k2 L | "
         "achieved k1 L, k2 L | error | reached | derivatives | rigid folds | seconds | why not |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for d in s["designs"]:
         r = get(ix, **d)
@@ -392,11 +432,17 @@ def table_design(ix: dict, s: dict) -> str:
             else "curvatures"
         )
         if r is None:
-            lines.append(f"| {d['pattern']} | | | {what} | | failed | | | | | | |")
+            lines.append(f"| {d['pattern']} | | | | {what} | | failed | | | | | | |")
             continue
         a, t = r["achieved"], r["target"]
+        v = r.get("variables")
+        control = (
+            "angles of the bh.dof actuators"
+            if v is None
+            else f"surface: β = {v['beta_deg']:.3g}°, κxL = {_f(v['kx_L'])}, κyL = {_f(v['ky_L'])}"
+        )
         lines.append(
-            f"| {d['pattern']} | {r['n_vertices']} | {r['n_actuators']} | {what} | "
+            f"| {d['pattern']} | {r['n_vertices']} | {control} | {r['n_actuators']} | {what} | "
             f"{_f(t[0], '.4g')}, {_f(t[1], '.4g')} | {_f(a[0], '.4g')}, {_f(a[1], '.4g')} | "
             f"{_f(100 * r['relative_error'], '.2g')} % | {'yes' if r['reached'] else 'no'} | "
             f"{'exact' if r['jac'] == 'exact' else 'forward differences'} | "
@@ -430,26 +476,191 @@ def table_signs(ix: dict, records: dict) -> str:
     ]
     for p in PATTERNS:
         for m in ("rigid", "bar-hinge"):
-            ks = [
-                r["result"]["KL2"]
-                for r in records.values()
-                if r["params"]["kind"] == "form"
-                and r["params"]["pattern"] == p
-                and r["status"] == "ok"
-                and r["result"]["model"] == m
-            ]
-            if not ks:
-                continue
-            pos = max(ks) > 1e-3
-            lines.append(
-                f"| {p} | {'rigid limit' if m == 'rigid' else 'bar-and-hinge'} | "
-                f"{len(ks)} | {_f(min(ks))} | {_f(max(ks))} | {'yes' if pos else 'no'} |"
-            )
+            for compliant in (False, True):
+                ks = form_KL2(records, p, m, compliant)
+                if not ks:
+                    continue
+                pos = max(ks) > 1e-3
+                name = ("rigid limit" if m == "rigid" else "bar-and-hinge") + (
+                    ", compliant actuators" if compliant else ""
+                )
+                lines.append(
+                    f"| {p} | {name} | {len(ks)} | {_f(min(ks))} | {_f(max(ks))} | "
+                    f"{'yes' if pos else 'no'} |"
+                )
     return "\n".join(lines)
 
 
+def form_KL2(records: dict, pattern: str, model: str, compliant: bool) -> list[float]:
+    """K L^2 of every finished form run of ``pattern`` by ``model`` ("rigid" or
+    "bar-hinge"), with held or compliant actuators."""
+    return [
+        r["result"]["KL2"]
+        for r in records.values()
+        if r["params"]["kind"] == "form"
+        and r["params"]["pattern"] == pattern
+        and r["status"] == "ok"
+        and r["result"]["model"] == model
+        and (r["params"].get("actuator_k") is not None) == compliant
+    ]
+
+
+# ------------------------------------------------------------------------------ findings
+MIURA_FAMILY = ("miura", "miura_arc", "miura_nonuniform", "russo_pleat")
+
+
+def _range(v: list[float], fmt: str = ".2g") -> str:
+    v = [x for x in v if x is not None and np.isfinite(x)]
+    if not v:
+        return "–"
+    lo, hi = min(v), max(v)
+    return _f(lo, fmt) if _f(lo, fmt) == _f(hi, fmt) else f"{_f(lo, fmt)} to {_f(hi, fmt)}"
+
+
+def findings(ix: dict, s: dict, records: dict, conv: list, comp: list, place: list) -> str:
+    """The findings of the study, every number computed from the records."""
+    out = []
+    rig = [
+        get(ix, pattern=p, spacing=sp, kappa_L=k)
+        for p in MIURA_FAMILY
+        for sp in s["spacings"]
+        for k in s["kappa_L"]
+    ]
+    rig = [r for r in rig if r is not None]
+    mis = [r["actuator_misfit_deg"] for r in rig if r["actuator_misfit_deg"] > 1e-6]
+    kmax = max((abs(r["KL2"]) for r in rig), default=float("nan"))
+    out.append(
+        "**The Miura family cannot be steered by a curve with rigid panels.** The Miura-ori, "
+        "the arc and non-uniform Miura-ori and the Russo pleat have one rigid DOF, so two or "
+        "more actuators with different targets over-determine them. The rigid limit meets "
+        f"curved targets only in least squares ({len(mis)} of {len(rig)} cells, misfit "
+        f"{_range(mis)}°) and stays globally developable (|K L²| ≤ {_f(kmax, '.1g')})."
+    )
+    held_in = [r for r in conv if r["ok"] and r["misfit_deg"] > 1e-6]
+    held_ok = [r for r in conv if r["ok"] and r["misfit_deg"] <= 1e-6]
+    bh_miura = form_KL2(records, "miura", "bar-hinge", False)
+    out.append(
+        "**Held actuators: the bar-and-hinge model reaches incompatible targets only by "
+        "straining.** Where the rigid limit has a misfit, the distance of the bar-and-hinge "
+        "model to it tends to that misfit instead of to zero (log-log slopes "
+        f"{_range([r['slope'] for r in held_in])} against the stiffness ratio, {len(held_in)} "
+        "cells): stiffer panels raise the actuator moments, they do not make the form rigid. "
+        "Where the targets are compatible the distance falls with r (slopes "
+        f"{_range([r['slope'] for r in held_ok])} over {len(held_ok)} cells, −1 being `1/r`; "
+        f"distances at r = {s['ratios'][-1]:g}: {_range([r['drho_deg'][-1] for r in held_ok])}°)."
+        + (
+            f" Every held bar-and-hinge Miura-ori run has `K < 0` (largest K L² "
+            f"{_f(max(bh_miura), '.2g')}), the sign of Schenk & Guest's saddle."
+            if bh_miura and max(bh_miura) < 0
+            else ""
+        )
+    )
+    c_ok = [r for r in comp if r["ok"]]
+    c_in = [r for r in c_ok if r["misfit_deg"] > 1e-6]
+    last = [r["drho_deg"][-1] for r in c_ok]
+    fam_last = [
+        abs(r["KL2_bh"][-1]) for r in c_ok if r["pattern"] in MIURA_FAMILY and r["kappa_L"] != 0
+    ]
+    out.append(
+        "**Compliant actuators make both models answer the same question.** With the actuators "
+        f"springs of {COMPLIANT_K:g} × the stiffest fold in both models, the bar-and-hinge model "
+        f"converges to the rigid limit in every cell that finished ({len(c_ok)} of {len(comp)}; "
+        f"the springs stretch {_range([r['misfit_deg'] for r in c_in])}° in the rigid limit): "
+        f"slopes {_range([r['slope'] for r in c_ok])}, largest fold-angle distance "
+        f"{_range(last)}° at r = {s['compliant_ratios'][-1]:g}."
+        + (
+            " The saddles of the held Miura family under curved targets vanish with it: "
+            f"|K L²| ≤ {_f(max(fam_last), '.2g')} at that ratio. They came from the strained "
+            "panels, not from the control."
+            if fam_last
+            else ""
+        )
+    )
+    signs = []
+    for p in PATTERNS:
+        ks = [k for m in ("rigid", "bar-hinge") for c in (False, True)
+              for k in form_KL2(records, p, m, c)]  # fmt: skip
+        if ks:
+            signs.append((p, max(ks), min(ks)))
+    never = [p for p, hi, _ in signs if hi <= 1e-3]
+    both = [f"{p} (K L² up to {_f(hi, '.2g')})" for p, hi, lo in signs if hi > 1e-3 and lo < -1e-3]
+    out.append(
+        "**Which sign of K a sheet can take is the pattern's, not the curve's.** "
+        + (
+            f"No run of {', '.join(never)} has K L² > 10⁻³, rigid or strained, held or compliant. "
+            if never
+            else ""
+        )  # fmt: skip
+        + (f"Both signs: {', '.join(both)}. " if both else "")
+        + "Circle, parabola and spline of the same apex curvature give similar forms (table "
+        "above): what matters is whether the targets are compatible."
+    )
+    multi = [r for r in place if r["n_dof"] > 1]
+    if multi:
+
+        def needs(r: dict, key: str) -> str:
+            n = r[f"{key}_needed"]
+            return f"fix it with {n}" if n else f"do not fix it with {r['counts'][-1]}"
+
+        parts = [
+            f"{r['pattern']} ({r['n_dof']} DOF): the bh.dof actuators {needs(r, 'dof')}, "
+            f"section-line creases {needs(r, 'section')} (form error at "
+            f"{r['counts'][-1]}: {_f(r['section'][-1], '.2g')}°)"
+            for r in multi
+        ]
+        out.append(
+            "**Actuators from the DOF analysis fix the form; section lines need not.** "
+            + "; ".join(parts)
+            + ". For the one-DOF patterns any one actuator fixes the form."
+        )
+    des = [(d, get(ix, **d)) for d in s["designs"] if d.get("jac") != "fd"]
+    done = [(d, r) for d, r in des if r is not None]
+
+    def name(d: dict) -> str:
+        what = (
+            f"{d['surface']} surface" if d.get("surface")
+            else f"k1 L, k2 L = {_f(d['target_k1L'], 'g')}, {_f(d['target_k2L'], 'g')}"
+        )  # fmt: skip
+        return f"{d['pattern']} ({what}, control: {d.get('control', 'actuators')})"
+
+    hit = [name(d) for d, r in done if r["reached"]]
+    miss = [f"{name(d)}: {r['reason']}" for d, r in done if not r["reached"]]
+    out.append(
+        f"**Design from a target.** {len(hit)} of {len(des)} designs reach their target within "
+        f"5 %: {', '.join(hit) or 'none'}. "
+        + ("Not reached, with the reason: " + "; ".join(miss) + "." if miss else "")
+    )
+    lo_col = [get(ix, pattern=p, spacing=1, kappa_L=-1.0) for p in MIURA_FAMILY]
+    hi_col = [get(ix, pattern=p, spacing=1, kappa_L=1.0) for p in MIURA_FAMILY]
+    if -1.0 in s["kappa_L"] and 1.0 in s["kappa_L"]:
+        a = [r["actuator_misfit_deg"] for r in lo_col if r is not None]
+        b = [r["actuator_misfit_deg"] for r in hi_col if r is not None]
+        if a and b and max(a) > 2.0 * max(b):
+            tail = (
+                ": the continuation from the flat state lands on another rigid mode there (a "
+                "partly unfolded sheet, visible in the forms figure), a local minimum of the "
+                "misfit, not the best rigid fit."
+            )
+        else:
+            tail = ": curves bent either way are fitted about equally well."
+        out.append(
+            f"**The κL = −1 column of the Miura family** has least-squares misfits of "
+            f"{_range(a)}° against {_range(b)}° at κL = +1" + tail
+        )
+    n_failed = sum(r["status"] != "ok" for r in records.values())
+    out.append(
+        f"**Failures**: {n_failed} of {len(records)} runs; each is listed above with its "
+        "reason, and no run falls back to another model silently."
+    )
+    return "\n".join(f"{i}. {t}" for i, t in enumerate(out, 1))
+
+
 # ------------------------------------------------------------------------------ figures
-def figure_convergence(rows: list[dict], s: dict, path: Path, stamp: str) -> None:
+def figure_convergence(
+    rows: list[dict], ratios: list[float], path: Path, stamp: str, title: str, solid: bool = False
+) -> None:
+    """Distance to the rigid limit against the stiffness ratio per cell (dotted: the rigid
+    limit misses the targets, unless ``solid``)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -460,17 +671,17 @@ def figure_convergence(rows: list[dict], s: dict, path: Path, stamp: str) -> Non
     seen = set()
     for row in rows:
         if row["ok"]:
-            ls = "-" if row["misfit_deg"] < 1e-6 else ":"
+            ls = "-" if solid or row["misfit_deg"] < 1e-6 else ":"
             p = row["pattern"]
-            ax.loglog(s["ratios"], np.maximum(row["drho_deg"], 1e-12), "o" + ls, ms=3,
+            ax.loglog(ratios, np.maximum(row["drho_deg"], 1e-12), "o" + ls, ms=3,
                       color=colour[p], label=None if p in seen else p)  # fmt: skip
             seen.add(p)
-    r = np.asarray(s["ratios"])
+    r = np.asarray(ratios)
     ax.loglog(r, 10 * r[0] / r, "k--", lw=0.8, label="slope −1")
     ax.set(
         xlabel="stiffness ratio r (bars and panels / default)",
         ylabel="max |ρ_bh − ρ_rigid| over creases (deg)",
-        title="bar-and-hinge → rigid limit (solid: compatible targets; dotted: least squares)",
+        title=title,
     )
     ax.title.set_fontsize(8)
     ax.legend(fontsize=6, ncol=2)
@@ -552,8 +763,24 @@ def publish(records: dict, quick: bool) -> None:
         return
     FULL_JSON.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n")
     conv = convergence(ix, s)
+    comp = convergence(ix, s, compliant=True)
     img = ROOT / "docs" / "img"
-    figure_convergence(conv, s, img / "transformations_convergence.png", stamp)
+    figure_convergence(
+        conv,
+        s["ratios"],
+        img / "transformations_convergence.png",
+        stamp,
+        "held actuators: bar-and-hinge → rigid limit (solid: compatible targets; dotted: "
+        "least squares)",
+    )
+    figure_convergence(
+        comp,
+        s["compliant_ratios"],
+        img / "transformations_compliant.png",
+        stamp,
+        f"compliant actuators ({COMPLIANT_K:g} × stiffest fold): bar-and-hinge → rigid limit",
+        solid=True,
+    )
     figure_forms(ix, s, quick, img / "transformations_forms.png", stamp)
     n_failed = sum(r["status"] != "ok" for r in records.values())
     text = DOC.read_text()
@@ -562,12 +789,14 @@ def publish(records: dict, quick: bool) -> None:
         f"--publish` ({stamp}; {len(records)} runs, {n_failed} failed).*",
         "rigid": table_rigid(ix, s),
         "convergence": table_convergence(conv, s),
+        "compliant": table_convergence(comp, s, compliant=True),
         "curves": table_curves(ix, s),
         "surfaces": table_surfaces(ix, s),
         "placement": table_placement(placement_rows(ix, s, quick)),
         "signs": table_signs(ix, records),
         "design": table_design(ix, s),
         "speedup": design_speedups(ix, s),
+        "findings": findings(ix, s, records, conv, comp, placement_rows(ix, s, quick)),
         "failed": "\n".join(
             f"* {_describe(r['params'])}: {r['error']['type']}: "
             f"{r['error']['message'].splitlines()[0][:160]}"

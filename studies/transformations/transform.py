@@ -7,6 +7,11 @@ See run.py for the study and docs/transformations.md for the results.
   ``model="rigid"`` is the energy-minimising rigid limit (``bh.rigid_fold``, incompatible
   targets met in least squares), ``model=r`` (a number) the bar-and-hinge model (N5B8) with
   bars and panel bending ``r`` times the default (``stiffness_ratio``).
+* ``actuator_k`` (any model): compliant actuators, springs of stiffness ``actuator_k`` x the
+  stiffest crease's fold stiffness pulling each actuator towards its target, instead of
+  held actuators. Both models then minimise the same fold-plus-actuator-spring energy, so the
+  bar-and-hinge model converges to the rigid limit as its panels stiffen even where the
+  targets are incompatible.
 * ``placement_point(pattern, quick, count, placement)`` folds a pattern to a reference rigid
   form with ``count`` actuators chosen by the DOF analysis (``bh.dof``) or along section
   lines, and returns the form error.
@@ -37,6 +42,8 @@ PATTERNS: dict[str, tuple[str, str, dict, dict]] = {
 }
 
 CURVES = ("circle", "parabola", "spline")
+#: stiffness of the compliant actuators, in units of the stiffest crease's fold stiffness
+COMPLIANT_K = 100.0
 #: Newton iterations of the rigid limit's energy minimisation per step
 ENERGY_MAX_ITER = 200
 
@@ -109,6 +116,15 @@ def rigid_weights(cp) -> np.ndarray:
     return w / float(w[cp.crease_edges].max())
 
 
+def fold_scale(cp) -> float:
+    """Fold stiffness of the stiffest crease of the default bar-and-hinge model (force x
+    length / rad): the unit of ``actuator_k``."""
+    from barhinge.solver.branch import fold_weights
+
+    w, _ = fold_weights(_model(cp, None))
+    return float(w[cp.crease_edges].max())
+
+
 def rigid_limit(cp, acts, steps: int):
     """The energy-minimising rigid fold (incompatible targets met in least squares)."""
     import barhinge as bh
@@ -120,8 +136,18 @@ def rigid_limit(cp, acts, steps: int):
     return bh.rigid_fold(cp, acts, steps=steps, fold_stiffness=rigid_weights(cp), options=opts)
 
 
-def _targets(cp, spacing: int, curve: str, kappa_L: float, ky_L: float | None):
-    """Actuators of one cell: base fold s_i * BASE_DEG plus the control rotation angles."""
+def _targets(
+    cp,
+    spacing: int,
+    curve: str,
+    kappa_L: float,
+    ky_L: float | None,
+    base_deg: float = BASE_DEG,
+    actuator_k: float | None = None,
+):
+    """Actuators of one cell: base fold s_i * base_deg plus the control rotation angles;
+    compliant with stiffness ``actuator_k`` (in the rigid limit's units: the stiffest
+    crease's fold stiffness is 1) when given."""
     import barhinge as bh
     from barhinge.actuators.curves import (
         ControlSurface,
@@ -149,7 +175,8 @@ def _targets(cp, spacing: int, curve: str, kappa_L: float, ky_L: float | None):
         edges, phi = acts.edges, acts.targets_deg
         d = None
     sign = np.where(cp.assignment[edges] == "M", -1.0, 1.0)
-    return bh.Actuators(edges=edges, targets_deg=sign * BASE_DEG + phi), L, d
+    acts = bh.Actuators(edges=edges, targets_deg=sign * base_deg + phi, stiffness=actuator_k)
+    return acts, L, d
 
 
 def point(
@@ -161,25 +188,31 @@ def point(
     model: str | float = "rigid",
     quick: bool = True,
     steps: int = 6,
+    actuator_k: float | None = None,
 ) -> dict:
     """Fold one pattern with one model; returns the global form and how it was reached."""
+    import dataclasses
+
     import barhinge as bh
 
     cp = make_pattern(pattern, quick)
-    acts, L, d = _targets(cp, spacing, curve, kappa_L, ky_L)
+    acts, L, d = _targets(cp, spacing, curve, kappa_L, ky_L, actuator_k=actuator_k)
     edges, targets = acts.edges, acts.targets_deg
+    held = "" if actuator_k is None else f", compliant actuators {actuator_k:g} x stiffest fold"
     if model == "rigid":
         path = rigid_limit(cp, acts, steps)
         curv = bh.gaussian_curvature(path, pattern=cp)
         misfit = path.meta.get("actuator_misfit_deg")
-        label = "rigid limit (energy-minimising)"
+        label = "rigid limit (energy-minimising)" + held
         free = path.meta.get("free_dof")
     else:
         m = _model(cp, float(model))
+        if actuator_k is not None:  # the same springs in the model's units
+            acts = dataclasses.replace(acts, stiffness=actuator_k * fold_scale(cp))
         path = bh.solve(bh.Scene(m, actuators=acts, steps=steps))
         curv = bh.gaussian_curvature(path, model=m)
-        misfit = None
-        label = f"bar-and-hinge N5B8, stiffness ratio {float(model):g}"
+        misfit = path.meta.get("actuator_misfit_deg") if actuator_k is not None else None
+        label = f"bar-and-hinge N5B8, stiffness ratio {float(model):g}" + held
         free = None
     rho = path.fold_angles_deg[-1]
     g = curv.global_fit
@@ -188,6 +221,7 @@ def point(
     return {
         "model": "rigid" if model == "rigid" else "bar-hinge",
         "model_label": label,
+        "actuator_k": actuator_k,
         "stiffness_ratio": None if model == "rigid" else float(model),
         "n_actuators": len(edges),
         "d_mean": d,
