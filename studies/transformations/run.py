@@ -545,8 +545,9 @@ def findings(ix: dict, s: dict, records: dict, conv: list, comp: list, place: li
         "model to it tends to that misfit instead of to zero (log-log slopes "
         f"{_range([r['slope'] for r in held_in])} against the stiffness ratio, {len(held_in)} "
         "cells): stiffer panels raise the actuator moments, they do not make the form rigid. "
-        "Where the targets are compatible it converges as `1/r` (slopes "
-        f"{_range([r['slope'] for r in held_ok])}, {len(held_ok)} cells)."
+        "Where the targets are compatible the distance falls with r (slopes "
+        f"{_range([r['slope'] for r in held_ok])} over {len(held_ok)} cells, −1 being `1/r`; "
+        f"distances at r = {s['ratios'][-1]:g}: {_range([r['drho_deg'][-1] for r in held_ok])}°)."
         + (
             f" Every held bar-and-hinge Miura-ori run has `K < 0` (largest K L² "
             f"{_f(max(bh_miura), '.2g')}), the sign of Schenk & Guest's saddle."
@@ -614,9 +615,16 @@ def findings(ix: dict, s: dict, records: dict, conv: list, comp: list, place: li
         )
     des = [(d, get(ix, **d)) for d in s["designs"] if d.get("jac") != "fd"]
     done = [(d, r) for d, r in des if r is not None]
-    hit = [f"{d['pattern']} ({d.get('control', 'actuators')})" for d, r in done if r["reached"]]
-    miss = [f"{d['pattern']} ({d.get('control', 'actuators')}): {r['reason']}"
-            for d, r in done if not r["reached"]]  # fmt: skip
+
+    def name(d: dict) -> str:
+        what = (
+            f"{d['surface']} surface" if d.get("surface")
+            else f"k1 L, k2 L = {_f(d['target_k1L'], 'g')}, {_f(d['target_k2L'], 'g')}"
+        )  # fmt: skip
+        return f"{d['pattern']} ({what}, control: {d.get('control', 'actuators')})"
+
+    hit = [name(d) for d, r in done if r["reached"]]
+    miss = [f"{name(d)}: {r['reason']}" for d, r in done if not r["reached"]]
     out.append(
         f"**Design from a target.** {len(hit)} of {len(des)} designs reach their target within "
         f"5 %: {', '.join(hit) or 'none'}. "
@@ -627,11 +635,17 @@ def findings(ix: dict, s: dict, records: dict, conv: list, comp: list, place: li
     if -1.0 in s["kappa_L"] and 1.0 in s["kappa_L"]:
         a = [r["actuator_misfit_deg"] for r in lo_col if r is not None]
         b = [r["actuator_misfit_deg"] for r in hi_col if r is not None]
+        if a and b and max(a) > 2.0 * max(b):
+            tail = (
+                ": the continuation from the flat state lands on another rigid mode there (a "
+                "partly unfolded sheet, visible in the forms figure), a local minimum of the "
+                "misfit, not the best rigid fit."
+            )
+        else:
+            tail = ": curves bent either way are fitted about equally well."
         out.append(
             f"**The κL = −1 column of the Miura family** has least-squares misfits of "
-            f"{_range(a)}° against {_range(b)}° at κL = +1: the continuation from the flat "
-            "state can land on another rigid mode (a partly unfolded sheet, visible in the "
-            "forms figure), a local minimum of the misfit, not the best rigid fit."
+            f"{_range(a)}° against {_range(b)}° at κL = +1" + tail
         )
     n_failed = sum(r["status"] != "ok" for r in records.values())
     out.append(
