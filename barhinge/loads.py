@@ -6,7 +6,9 @@
 * :func:`projected_load` -- a load ``q`` per unit area projected on the plane normal to a
   direction (snow: per unit plan area, downwards), acting along that direction;
 * :func:`line_load` -- a force per unit length along pattern edges (creases or boundaries);
-* :func:`combine` -- ``sum factor_c * case_c``.
+* :func:`combine` -- ``sum factor_c * case_c``;
+* :class:`FollowerPressure` -- a pressure along each facet's *current* normal (a follower
+  load: it turns with the panels), evaluated by the solver at every iterate.
 
 Area loads are lumped: each face's resultant is shared equally by its corners (the resultant
 is exact; the same rule as :func:`barhinge.scene.self_weight`). A line load's resultant on an
@@ -15,14 +17,23 @@ edge is shared equally by its two end vertices. Units are the user's.
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
 
 from barhinge import _check
 from barhinge.errors import ConfigError
 
-__all__ = ["pressure_load", "projected_load", "line_load", "combine", "face_vectors"]
+__all__ = [
+    "FollowerPressure",
+    "combine",
+    "face_vectors",
+    "line_load",
+    "pressure_load",
+    "projected_load",
+]
 
 
 def face_vectors(model: Any, faces: Any = None) -> tuple[np.ndarray, list[list[int]]]:
@@ -99,3 +110,87 @@ def combine(cases: dict[str, np.ndarray], factors: dict[str, float]) -> np.ndarr
         out = term if out is None else out + term
     assert out is not None
     return out
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class FollowerPressure:
+    """A pressure ``p`` (force per unit area, the user's units) along each facet's current
+    normal: a follower load, which turns with the panels as they rotate.
+
+    A facet with corners ``x_1 .. x_n`` (the pattern face's vertex order; ``+z`` for a
+    counter-clockwise flat pattern) carries ``p S`` with ``S = 1/2 sum_i x_i x x_{i+1}`` its
+    vector area (exact for a planar facet), shared equally by its corners, as
+    :func:`pressure_load` does at the reference state. Its derivative is
+    ``dS/dx_j = 1/2 [x_{j-1} - x_{j+1}]_x`` (skew matrix of the corner's two neighbours). The
+    load stiffness is not symmetric for an open surface; the solver's residual uses the exact
+    load and its tangent the symmetric part of the load stiffness (its factorisations are
+    symmetric), so converged states are exact while Newton converges linearly where the
+    skew part matters.
+
+    Parameters
+    ----------
+    p : float
+        Pressure, force per unit area (times the load factor).
+    faces : (k,) int, optional
+        Pattern faces loaded (default all).
+    """
+
+    p: float
+    faces: Any = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "p", _check.number(self.p, "follower pressure"))
+
+    def _groups(self, model: Any) -> list[np.ndarray]:
+        """Face corner arrays (k_n, n), one per corner count n."""
+        cp = model.pattern
+        ids = (
+            np.arange(cp.n_faces)
+            if self.faces is None
+            else _check.int_array(self.faces, "faces", 0, cp.n_faces - 1)
+        )
+        by_n: dict[int, list[list[int]]] = {}
+        for f in ids:
+            face = list(cp.faces[int(f)])
+            by_n.setdefault(len(face), []).append(face)
+        return [np.asarray(v, np.int64) for v in by_n.values()]
+
+    def force(self, model: Any, X: np.ndarray) -> np.ndarray:
+        """(n_dof,) nodal forces at coordinates ``X`` (n_nodes, 3), force."""
+        X = np.asarray(X, float).reshape(-1, 3)
+        out = np.zeros_like(X)
+        for F in self._groups(model):
+            P = X[F]  # (k, n, 3)
+            S = 0.5 * np.cross(P, np.roll(P, -1, axis=1)).sum(axis=1)  # (k, 3)
+            share = (self.p / F.shape[1]) * S
+            np.add.at(out, F.ravel(), np.repeat(share, F.shape[1], axis=0))
+        return out.ravel()
+
+    def stiffness(self, model: Any, X: np.ndarray) -> sp.csr_matrix:
+        """(n_dof, n_dof) load stiffness ``d force / dX`` (not symmetric), force / length."""
+        X = np.asarray(X, float).reshape(-1, 3)
+        n = X.size
+        rows, cols, vals = [], [], []
+        for F in self._groups(model):
+            k, m = F.shape
+            P = X[F]
+            d = 0.5 * (np.roll(P, 1, axis=1) - np.roll(P, -1, axis=1))  # x_{j-1} - x_{j+1}
+            # skew matrix [d]_x: [d]_x v = d x v, per corner j: (k, m, 3, 3)
+            W = np.zeros((k, m, 3, 3))
+            W[..., 0, 1], W[..., 0, 2] = -d[..., 2], d[..., 1]
+            W[..., 1, 0], W[..., 1, 2] = d[..., 2], -d[..., 0]
+            W[..., 2, 0], W[..., 2, 1] = -d[..., 1], d[..., 0]
+            W *= self.p / m
+            # every corner i of the face gets dS/dx_j: blocks (i, j) for all i, j
+            ri = 3 * F[:, :, None, None, None] + np.arange(3)[None, None, None, :, None]
+            cj = 3 * F[:, None, :, None, None] + np.arange(3)[None, None, None, None, :]
+            ri, cj = np.broadcast_arrays(ri, cj)
+            v = np.broadcast_to(W[:, None, :, :, :], (k, m, m, 3, 3))
+            rows.append(ri.ravel())
+            cols.append(cj.ravel())
+            vals.append(v.ravel())
+        if not rows:
+            return sp.csr_matrix((n, n))
+        return sp.csr_matrix(
+            (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n)
+        )

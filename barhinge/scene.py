@@ -22,7 +22,7 @@ from barhinge import _check
 from barhinge._typing import ControlKind
 from barhinge.actuators import Actuators
 from barhinge.errors import BarhingeError, ConfigError, PatternError
-from barhinge.loads import combine, line_load, pressure_load, projected_load
+from barhinge.loads import FollowerPressure, combine, line_load, pressure_load, projected_load
 from barhinge.solver_options import SolverOptions
 
 __all__ = [
@@ -64,6 +64,9 @@ class Scene:
     load_cases : dict str -> (n_nodes, 3) float, optional
         Named load cases and factored combinations (reference loads); pick one with
         :meth:`with_load_case`.
+    follower : FollowerPressure, optional
+        A pressure along the facets' current normals, scaled by the load factor with
+        ``loads`` (a follower load: re-evaluated at every iterate).
     """
 
     model: Any
@@ -76,6 +79,7 @@ class Scene:
     options: SolverOptions | dict | None = None
     name: str = "scene"
     load_cases: dict[str, np.ndarray] | None = None
+    follower: FollowerPressure | None = None
 
     def __post_init__(self) -> None:
         if not hasattr(self.model, "n_nodes") or not hasattr(self.model, "X0"):
@@ -128,7 +132,12 @@ class Scene:
             raise ConfigError("control 'fold_angle' needs actuators")
         if control == "displacement" and not np.isfinite(P).any():
             raise ConfigError("control 'displacement' needs prescribed displacements")
-        if control in ("load", "arc_length") and not np.any(L):
+        fol = self.follower
+        if fol is not None and not isinstance(fol, FollowerPressure):
+            raise ConfigError(f"follower must be a FollowerPressure, got {type(fol).__name__}")
+        if fol is not None:
+            fol.force(self.model, self.model.X0)  # checks the faces
+        if control in ("load", "arc_length") and not np.any(L) and (fol is None or fol.p == 0):
             raise ConfigError(f"control {control!r} needs nonzero loads")
         opts = self.options
         if opts is None or isinstance(opts, dict):
@@ -365,13 +374,15 @@ def _scene_from_dict(d: dict[str, Any], base_dir: Path) -> Scene:
             key = f"supports.{i}"
             _check_keys(g, _SELECT | {"dofs"}, key)
             supports[np.ix_(_nodes(model, g, key), _dofs(g, key))] = True
-    loads = _loads_from(model, d["loads"], "loads") if "loads" in d else None
+    loads, follower = (
+        _loads_from(model, d["loads"], "loads", follower=True) if "loads" in d else (None, None)
+    )
     cases: dict[str, np.ndarray] = {}
     lc = d.get("load_cases", {})
     if not isinstance(lc, dict):
         raise ConfigError(f"load_cases must be a table of named cases, got {_check.show(lc)}")
     for cname, groups in lc.items():
-        cases[cname] = _loads_from(model, groups, f"load_cases.{cname}")
+        cases[cname] = _loads_from(model, groups, f"load_cases.{cname}")[0]
     combos = d.get("combinations", {})
     if not isinstance(combos, dict):
         raise ConfigError(f"combinations must be a table, got {_check.show(combos)}")
@@ -436,18 +447,41 @@ def _scene_from_dict(d: dict[str, Any], base_dir: Path) -> Scene:
         options=options,
         name=name,
         load_cases=cases or None,
+        follower=follower,
     )
 
 
-def _loads_from(model: Any, groups: Any, where: str) -> np.ndarray:
+def _loads_from(
+    model: Any, groups: Any, where: str, follower: bool = False
+) -> tuple[np.ndarray, FollowerPressure | None]:
     """(n_nodes, 3) reference loads of an array of load groups (forces on selected nodes,
-    self-weight, pressure, projected and line loads)."""
+    self-weight, pressure, projected and line loads), and the follower pressure (a group
+    with ``pressure`` and ``follower = true``; allowed where ``follower``)."""
     n = model.n_nodes
     loads = np.zeros((n, 3))
+    fol: FollowerPressure | None = None
     kinds = {"force", "self_weight", "pressure", "projected", "line_load"}
     for i, g in enumerate(_groups(groups, where)):
         key = f"{where}.{i}"
-        _check_keys(g, _SELECT | kinds | {"faces"}, key)
+        _check_keys(g, _SELECT | kinds | {"faces", "follower"}, key)
+        if "follower" in g:
+            if not isinstance(g["follower"], bool):
+                raise ConfigError(
+                    f"{key}.follower = {_check.show(g['follower'])}; expected true/false"
+                )
+            if g["follower"] and set(g) - {"pressure", "faces", "follower"}:
+                raise ConfigError(f"{key}: a follower group holds pressure (and faces) only")
+            if g["follower"] and "pressure" not in g:
+                raise ConfigError(f"{key}.follower = true needs pressure = p")
+            if g["follower"] and not follower:
+                raise ConfigError(f"{key}: follower pressure goes in [[loads]], not in load cases")
+            if g["follower"] and fol is not None:
+                raise ConfigError(f"{key}: one follower pressure per scene")
+            if g["follower"]:
+                with _check.prefixed(f"{key}."):
+                    fol = FollowerPressure(g["pressure"], g.get("faces"))
+                    fol.force(model, model.X0)  # checks the faces
+                continue
         if not set(g) & kinds:
             raise ConfigError(
                 f"{key} needs force = [fx, fy, fz], self_weight, pressure, projected or line_load"
@@ -488,7 +522,7 @@ def _loads_from(model: Any, groups: Any, where: str) -> np.ndarray:
             raise ConfigError(f"{key} selects nodes but gives no force = [fx, fy, fz]")
         if not np.isfinite(loads).all():
             raise ConfigError(f"{key}: the loads overflow floating point")
-    return loads
+    return loads, fol
 
 
 CONTROLS: tuple[str, ...] = (*typing.get_args(ControlKind), "auto")

@@ -4,8 +4,9 @@ factorisation of the bordered system (:class:`SolveContext`)."""
 
 from __future__ import annotations
 
+import dataclasses
 import time
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -43,6 +44,8 @@ class SolveContext:
         self.fixed: np.ndarray = scene.fixed.ravel()
         self.free: np.ndarray = ~self.fixed
         self.P: np.ndarray = scene.loads.ravel()
+        #: follower pressure (load at the current geometry), None without
+        self.follower = scene.follower
         assert scene.prescribed is not None
         pres = scene.prescribed.ravel()
         self.u_pres = np.where(np.isfinite(pres), pres, 0.0)
@@ -108,8 +111,16 @@ class SolveContext:
         ev = self.model.evaluate(X, tangent=tangent)
         self.timer.n_force_only += not tangent
         terms = actuator_terms(self.model, X, self.hinges)
+        P = self.P
+        if self.follower is not None:
+            P = P + self.follower.force(self.model, X)
+            if ev.K is not None and st.lam != 0.0:
+                # the symmetric part of the load stiffness (exact residual, symmetric tangent)
+                Kl = self.follower.stiffness(self.model, X)
+                K = (ev.K - (0.5 * st.lam) * (Kl + Kl.T)).tocsr()
+                ev = dataclasses.replace(cast(Any, ev), K=K)  # the model's frozen dataclass
         self.timer.assembly += time.perf_counter() - t0
-        r = np.asarray(ev.force, float).ravel() - st.lam * self.P
+        r = np.asarray(ev.force, float).ravel() - st.lam * P
         mu_act = st.mu
         if self.k_act is not None:  # compliant: spring moments k (rho - target)
             mu_act = self.k_act * _wrap(terms.rho - self.targets(st.t))
@@ -121,7 +132,7 @@ class SolveContext:
             self.force_floor = 1e-12 * float(d.max() if d.size else 1.0) * self.size
         if self.penalty is None:
             self.penalty = self._auto_penalty(ev.K, terms)
-        return Evaluation(ev, terms, r, c, mu_act)
+        return Evaluation(ev, terms, r, c, mu_act, P)
 
     def _auto_penalty(self, K: Any, terms: ActuatorTerms) -> float:
         a = self.opts.augmentation

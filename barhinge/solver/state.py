@@ -36,6 +36,9 @@ class Evaluation:
     #: (n_drive,) actuator multipliers, force x length: ``mu`` of held actuators, the
     #: spring moment ``k (rho - target)`` of compliant ones (the actuator moment is minus it)
     mu_act: np.ndarray | None = None
+    #: (n_dof,) reference load at this iterate, force (the fixed loads plus any follower
+    #: pressure at the current geometry); None: the scene's fixed loads
+    P: np.ndarray | None = None
 
 
 class IncrementFailed(Exception):

@@ -38,7 +38,8 @@ class WorkIntegrator:
         R = np.zeros(self.P.size)
         R[self.fixed] = e.r[self.fixed]
         q = np.concatenate([st.x, e.terms.rho])
-        F = np.concatenate([st.lam * self.P + R, -(st.mu if e.mu_act is None else e.mu_act)])
+        P = self.P if e.P is None else e.P
+        F = np.concatenate([st.lam * P + R, -(st.mu if e.mu_act is None else e.mu_act)])
         return t, q, F
 
     def add(self, first: StepRecord, new: State, e_new: Evaluation, s: float | None) -> None:
