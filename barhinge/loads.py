@@ -140,8 +140,40 @@ class FollowerPressure:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "p", _check.number(self.p, "follower pressure"))
+        object.__setattr__(self, "_cache", {})
 
     def _groups(self, model: Any) -> list[np.ndarray]:
+        """:meth:`_face_groups`, built once per pattern."""
+        return self._cached("groups", model, self._face_groups)
+
+    def _pattern(self, model: Any) -> tuple[np.ndarray, np.ndarray]:
+        """(rows, cols) of every entry of the load stiffness, in the order of its values
+        (built once per pattern)."""
+        return self._cached("pattern", model, self._stiffness_pattern)
+
+    def _cached(self, name: str, model: Any, build: Any) -> Any:
+        """``build(model)``, kept while the model's pattern is the same object."""
+        cache: dict = self._cache  # type: ignore[attr-defined]
+        hit = cache.get(name)
+        if hit is None or hit[0] is not model.pattern:
+            hit = cache[name] = (model.pattern, build(model))
+        return hit[1]
+
+    def _stiffness_pattern(self, model: Any) -> tuple[np.ndarray, np.ndarray]:
+        rows, cols = [], []
+        for F in self._groups(model):
+            ri = 3 * F[:, :, None, None, None] + np.arange(3)[None, None, None, :, None]
+            cj = 3 * F[:, None, :, None, None] + np.arange(3)[None, None, None, None, :]
+            ri, cj = np.broadcast_arrays(ri, cj)
+            rows.append(ri.ravel())
+            cols.append(cj.ravel())
+        empty = np.zeros(0, np.int64)
+        return (
+            np.concatenate(rows) if rows else empty,
+            np.concatenate(cols) if cols else empty,
+        )
+
+    def _face_groups(self, model: Any) -> list[np.ndarray]:
         """Face corner arrays (k_n, n), one per corner count n."""
         cp = model.pattern
         ids = (
@@ -170,7 +202,7 @@ class FollowerPressure:
         """(n_dof, n_dof) load stiffness ``d force / dX`` (not symmetric), force / length."""
         X = np.asarray(X, float).reshape(-1, 3)
         n = X.size
-        rows, cols, vals = [], [], []
+        vals = []
         for F in self._groups(model):
             k, m = F.shape
             P = X[F]
@@ -182,15 +214,8 @@ class FollowerPressure:
             W[..., 2, 0], W[..., 2, 1] = -d[..., 1], d[..., 0]
             W *= self.p / m
             # every corner i of the face gets dS/dx_j: blocks (i, j) for all i, j
-            ri = 3 * F[:, :, None, None, None] + np.arange(3)[None, None, None, :, None]
-            cj = 3 * F[:, None, :, None, None] + np.arange(3)[None, None, None, None, :]
-            ri, cj = np.broadcast_arrays(ri, cj)
-            v = np.broadcast_to(W[:, None, :, :, :], (k, m, m, 3, 3))
-            rows.append(ri.ravel())
-            cols.append(cj.ravel())
-            vals.append(v.ravel())
-        if not rows:
+            vals.append(np.broadcast_to(W[:, None, :, :, :], (k, m, m, 3, 3)).ravel())
+        if not vals:
             return sp.csr_matrix((n, n))
-        return sp.csr_matrix(
-            (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n)
-        )
+        rows, cols = self._pattern(model)
+        return sp.csr_matrix((np.concatenate(vals), (rows, cols)), shape=(n, n))

@@ -40,7 +40,7 @@ def arc_increment(
     if not factored:
         ctx.factorize_or_fail(e, st, res)
     zc = np.zeros(ctx.n_act)
-    u_hat, mu_hat = ctx.system.solve(_load(ctx, e)[free], zc)
+    u_hat, mu_hat = ctx.system.solve(e.P[free], zc)
     sgn = gdcm_sign(prev_tan, u_hat, sign)
     base = first_tan if first_tan is not None else u_hat
     dlam = sgn * dl0 * gdcm_scale(base, prev_tan, u_hat)
@@ -62,7 +62,7 @@ def arc_increment(
         if it >= o.max_iter:
             raise IncrementFailed(f"no convergence in {o.max_iter} iterations", res)
         ctx.factorize_or_fail(e, new, res)
-        uh, mh = ctx.system.solve(_load(ctx, e)[free], zc)
+        uh, mh = ctx.system.solve(e.P[free], zc)
         ub, mb = ctx.system.solve(-e.r[free], -e.c)
         dl = -float(tan1 @ ub) / float(tan1 @ uh)
         dx = dl * uh + ub
@@ -109,7 +109,7 @@ def land_displacement(
         except SingularMatrixError as exc:
             why = f"singular tangent ({exc})"
             break
-        uh, mh = ctx.system.solve(_load(ctx, e)[free], zc)
+        uh, mh = ctx.system.solve(e.P[free], zc)
         ub, mb = ctx.system.solve(-e.r[free], -e.c)
         if uh[k] == 0.0:
             why = "the load does not move the stopping component"
@@ -155,8 +155,3 @@ def stop_text(ctx: SolveContext, lam_stop: float | None, disp: tuple[int, float]
     if o.arc_stop_limit_points is not None:
         parts.append(f"{o.arc_stop_limit_points} limit point(s)")
     return "before reaching " + " or ".join(parts)
-
-
-def _load(ctx: SolveContext, e: Evaluation) -> np.ndarray:
-    """The reference load at the iterate of ``e`` (follower pressure at its geometry)."""
-    return ctx.P if e.P is None else e.P

@@ -156,7 +156,6 @@ class SolveContext:
         check_finite_tangent(e.ev.K)  # NaN / inf never reach the factorisation
         springs = None
         if self.k_act is not None:
-            assert e.mu_act is not None  # set by evaluate
             springs = (e.mu_act, self.k_act)
         self.system.set_operator(
             e.ev.K, e.terms, st.mu, self.penalty or 0.0, factorize=not reuse, springs=springs

@@ -22,8 +22,7 @@ class Convergence:
     def force_ref(self, e: Evaluation, st: State) -> float:
         """Force scale of the convergence test."""
         ctx = self.ctx
-        P = ctx.P if e.P is None else e.P
-        parts = [float(np.linalg.norm(st.lam * P)), float(ctx.floor)]
+        parts = [float(np.linalg.norm(st.lam * e.P)), float(ctx.floor)]
         f = np.asarray(e.ev.force, float).ravel()
         parts.append(float(np.linalg.norm(f[ctx.fixed])) if ctx.fixed.any() else 0.0)
         if ctx.n_act:

@@ -167,7 +167,7 @@ class _Driver:
             return new
         e = ctx.evaluate(st)
         du_c = ctx.fixed_coords(t1) - st.x[fixed]
-        rhs = -(e.r - (lam1 - st.lam) * (ctx.P if e.P is None else e.P))
+        rhs = -(e.r - (lam1 - st.lam) * e.P)
         if du_c.size and np.any(du_c):
             dfull = np.zeros(ctx.n_dof)
             dfull[fixed] = du_c

@@ -39,7 +39,7 @@ def make_record(
     ev = e.ev
     R = np.zeros(ctx.n_dof)
     R[ctx.fixed] = e.r[ctx.fixed]  # f_int + G^T mu - lam P at supports
-    moments = -(st.mu if e.mu_act is None else e.mu_act)
+    moments = -e.mu_act
     return StepRecord(
         X=X.copy(),
         fold=np.asarray(ctx.model.crease_fold_angles_deg(X), float),

@@ -35,10 +35,10 @@ class Evaluation:
     c: np.ndarray  # (n_act,) rho - target, rad (held actuators; empty for compliant ones)
     #: (n_drive,) actuator multipliers, force x length: ``mu`` of held actuators, the
     #: spring moment ``k (rho - target)`` of compliant ones (the actuator moment is minus it)
-    mu_act: np.ndarray | None = None
+    mu_act: np.ndarray
     #: (n_dof,) reference load at this iterate, force (the fixed loads plus any follower
-    #: pressure at the current geometry); None: the scene's fixed loads
-    P: np.ndarray | None = None
+    #: pressure at the current geometry)
+    P: np.ndarray
 
 
 class IncrementFailed(Exception):

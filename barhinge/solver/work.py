@@ -38,8 +38,7 @@ class WorkIntegrator:
         R = np.zeros(self.P.size)
         R[self.fixed] = e.r[self.fixed]
         q = np.concatenate([st.x, e.terms.rho])
-        P = self.P if e.P is None else e.P
-        F = np.concatenate([st.lam * P + R, -(st.mu if e.mu_act is None else e.mu_act)])
+        F = np.concatenate([st.lam * e.P + R, -e.mu_act])
         return t, q, F
 
     def add(self, first: StepRecord, new: State, e_new: Evaluation, s: float | None) -> None:
