@@ -63,6 +63,8 @@ BEND_COEFFICIENT_F17 = 0.55
 #: lower bound of a bar area in the fit, as a fraction of t * face area / total bar length
 #: (keeps every bar load-bearing, so no in-plane mechanism appears; see docs/calibration.md)
 MIN_AREA_FRACTION = 0.1
+#: relative weight of the ridge that picks the smallest of equally good bounded bar fits
+BOUNDED_FIT_RIDGE = 1.0e-8
 #: weight of the dilation row of the ``"dilation"`` bar calibration (relative to the six
 #: moduli rows): the row's residual is ~ 1/weight^2 of the others'
 DILATION_WEIGHT = 1.0e4
@@ -173,20 +175,26 @@ def topo_lengths(X: np.ndarray, bars: np.ndarray) -> np.ndarray:
 
 def _bounded_fits(G: np.ndarray, y: np.ndarray, a_min: np.ndarray) -> np.ndarray:
     """Least squares ``G a ~ y`` with ``a >= a_min``, bars of equal direction tied to one
-    area (so a symmetric panel gets a symmetric answer). Faces of the same shape are solved
-    once (keyed on the rounded problem)."""
-    scale = np.abs(G).max(axis=(1, 2))
-    key = np.round(
-        np.concatenate(
-            [G.reshape(len(G), -1) / scale[:, None], y / scale[:, None], (a_min / scale)[:, None]],
-            axis=1,
-        ),
-        9,
-    )
+    area (so a symmetric panel gets a symmetric answer).
+
+    The problem is made dimensionless first (areas in units of ``a_min``, rows in units of
+    the largest modulus), so the answer scales exactly with the panel: the same shape in
+    millimetres or metres gets the same bar stiffnesses ``E A / L`` per unit thickness. Where
+    several area sets fit equally well (more bars than moduli), the smallest one is taken
+    (a ridge of weight ``BOUNDED_FIT_RIDGE`` relative to the weakest direction the moduli
+    fix), the bounded counterpart of the
+    minimum-norm ``pinv`` fit used where no bound is active. Faces of the same shape are
+    solved once (keyed on the rounded dimensionless problem)."""
+    from scipy.optimize import lsq_linear  # lazy: scipy.optimize costs ~0.15 s to import
+
+    y_scale = np.abs(y).max(axis=1)
+    Gn = G * (a_min / y_scale)[:, None, None]  # unknowns b = a / a_min >= 1
+    yn = y / y_scale[:, None]
+    key = np.round(np.concatenate([Gn.reshape(len(G), -1), yn], axis=1), 9)
     _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
     out = np.empty((len(first), G.shape[2]))
     for u, f in enumerate(first):
-        Gf = G[f]
+        Gf = Gn[f]
         cols = Gf / np.linalg.norm(Gf, axis=0)
         group = -np.ones(Gf.shape[1], dtype=np.int64)
         ng = 0
@@ -198,11 +206,17 @@ def _bounded_fits(G: np.ndarray, y: np.ndarray, a_min: np.ndarray) -> np.ndarray
             ng += 1
         Gt = np.zeros((Gf.shape[0], ng))
         np.add.at(Gt.T, group, Gf.T)
-        from scipy.optimize import lsq_linear  # lazy: scipy.optimize costs ~0.15 s to import
-
-        res = lsq_linear(Gt, y[f], bounds=(a_min[f], np.inf))
+        # |a|^2 = sum over groups of (bars in the group) * b_g^2: the ridge rows, weighted
+        # against the weakest direction the moduli fix (so that a heavily weighted row, the
+        # dilation rule's, does not let the ridge bend the fit of the others)
+        sv = np.linalg.svd(Gt, compute_uv=False)
+        ridge = np.sqrt(BOUNDED_FIT_RIDGE) * float(sv[sv > 1e-12 * sv[0]].min())
+        R = np.diag(ridge * np.sqrt(np.bincount(group, minlength=ng)))
+        A = np.vstack([Gt, R])
+        rhs = np.concatenate([yn[f], np.zeros(ng)])
+        res = lsq_linear(A, rhs, bounds=(1.0, np.inf), method="bvls")
         out[u] = res.x[group]
-    return out[inv.ravel()]
+    return out[inv.ravel()] * a_min[:, None]
 
 
 def bar_areas(

@@ -105,9 +105,13 @@ def test_two_separate_sheets_are_named():
 
 @pytest.mark.parametrize("scale", [1e12, 1e-6])
 def test_restraint_and_solve_are_scale_free(scale):
-    """a = b = 1e12 used to give "its vertices are collinear" (absolute tolerance)."""
+    """a = b = 1e12 used to give "its vertices are collinear" (absolute tolerance). The sheet
+    is drawn in other units: lengths and thickness times ``scale``, the fold stiffness per
+    unit length (a moment per radian per length, ~ E t^3) times ``scale^2``, so the
+    mechanics are the same at every scale."""
     cp = bh.families.miura(2, 2, a=scale, b=scale, fold=20.0)
-    m = bh.BarHingeModel.from_pattern(cp, fold_stiffness=1.0)
+    mat = bh.Material(t=bh.Material().t * scale)
+    m = bh.BarHingeModel.from_pattern(cp, "N5B8", mat, fold_stiffness=scale**2)
     S = restraint_321(m)
     assert S.sum() == 6
     e = int(cp.crease_edges[12])
