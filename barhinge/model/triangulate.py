@@ -2,8 +2,9 @@
 
 * triangles are kept as they are;
 * quadrilaterals by ``N4B5`` (split along the shorter diagonal, which becomes a bending
-  hinge) or ``N5B8`` (a centre node at the mean of the four corners joined to them: 8 bars,
-  4 bending hinges) -- Filipov et al. (2017, IJSS, Fig. 5);
+  hinge; corners 0-2 when the two are equal to round-off) or ``N5B8`` (a centre node at the
+  mean of the four corners joined to them: 8 bars, 4 bending hinges) -- Filipov et al.
+  (2017, IJSS, Fig. 5);
 * polygons with more than four corners by a centre node (mean of the corners) joined to every
   corner, in both schemes.
 
@@ -73,8 +74,10 @@ def triangulate(cp: CreasePattern, scheme: Scheme = "N5B8") -> Triangulation:
         if k == 4 and scheme == "N4B5":
             d02 = np.linalg.norm(V[F[:, 2]] - V[F[:, 0]], axis=1)
             d13 = np.linalg.norm(V[F[:, 3]] - V[F[:, 1]], axis=1)
-            # roll so that the split diagonal is always corners 0-2
-            Fr = np.where((d13 < d02)[:, None], np.roll(F, -1, axis=1), F)
+            # roll so that the split diagonal is always corners 0-2; diagonals equal to
+            # round-off (squares, rectangles) keep 0-2, whatever the units
+            shorter13 = d13 < d02 * (1.0 - 1e-9)
+            Fr = np.where(shorter13[:, None], np.roll(F, -1, axis=1), F)
             tris.append(np.stack([Fr[:, [0, 1, 2]], Fr[:, [0, 2, 3]]], axis=1).reshape(-1, 3))
             tface.append(np.repeat(fid, 2))
             continue

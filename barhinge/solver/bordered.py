@@ -139,6 +139,14 @@ class _DirectSolver:
         return dx, dmu
 
 
+#: from this many actuators on, the inertia of the released tangent (Haynsworth's formula:
+#: one solve per actuator with the bordered factor) is read from a factorisation of the
+#: released tangent itself instead: a 40 x 40 Miura fold with 80 actuators spent 0.33 s per
+#: state on the solves against 0.18 s per factorisation, and the solves grow with the
+#: number of actuators
+RELEASED_FACTOR_MIN_ACT = 8
+
+
 @dataclasses.dataclass
 class _KKTSolver:
     """A factorisation of the augmented bordered matrix ``[A G^T; G 0]`` itself."""
@@ -226,6 +234,11 @@ class BorderedSystem:
         self._kkt_gather: np.ndarray | None = None
         self._kkt_g: tuple[np.ndarray, np.ndarray] | None = None
         self._kkt_pattern: tuple | None = None
+        # (values of the factorised bordered operator's A, its penalty blocks) for the
+        # released tangent's inertia; a backend of its own keeps that factor apart
+        self._penalty_blocks: np.ndarray | None = None
+        self._released: tuple[np.ndarray, np.ndarray] | None = None
+        self._released_backend: LinearBackend | None = None
 
     # ---------------------------------------------------------------- structure
     def _prepare(self, K: sp.csr_matrix) -> None:
@@ -319,7 +332,8 @@ class BorderedSystem:
                 m[:, None, None] * terms.hess + k[:, None, None] * g[:, :, None] * g[:, None, :]
             )
         elif na:
-            blocks = mu[:, None, None] * terms.hess + penalty * g[:, :, None] * g[:, None, :]
+            self._penalty_blocks = penalty * g[:, :, None] * g[:, None, :]
+            blocks = mu[:, None, None] * terms.hess + self._penalty_blocks
         else:
             blocks = np.zeros((0, 12, 12))
         self._data_full = self._free_data(K, blocks)
@@ -449,6 +463,12 @@ class BorderedSystem:
         if self.Gf is None:
             return int(n_b)
         na = self.Gf.shape[0]
+        if (
+            isinstance(direct, _KKTSolver)
+            and na >= RELEASED_FACTOR_MIN_ACT
+            and self._released is not None
+        ):
+            return self._released_inertia()
         if isinstance(direct, _DirectSolver):
             assert direct.S_inv is not None  # kept with actuators
             S_inv = 0.5 * (direct.S_inv + direct.S_inv.T)  # (G A^-1 G^T)^-1
@@ -480,7 +500,33 @@ class BorderedSystem:
             return False
         self._record_inertia(na)  # inertia(KKT) = inertia(A) + inertia(-S), S > 0 when A > 0
         self._keep(_KKTSolver(self.factor, self.Gf, self.penalty), t_start)
+        ok = self._blk_ok and self._penalty_blocks is not None and self._data_full is not None
+        self._released = (self._data_full, self._penalty_blocks) if ok else None  # type: ignore[assignment]
         return True
+
+    def _released_inertia(self) -> int | None:
+        """Negative eigenvalues of the released tangent ``K_t = A - p G^T G`` of the last
+        bordered factorisation, from a factorisation of ``K_t`` itself (a backend of its
+        own, so the bordered factor stays alive); None when its backend gives no inertia."""
+        assert self._released is not None and self._blk_pos is not None
+        assert self._sel is not None and self._sub_indptr is not None
+        data, pen = self._released
+        released = data.copy()
+        np.add.at(released, self._blk_pos, -pen.ravel())
+        nf = len(self.free_idx)
+        Kt = sp.csr_matrix((released[self._sel], self._sub_indices, self._sub_indptr), (nf, nf))
+        if self._released_backend is None:
+            self._released_backend = type(self.backend)()
+        t0 = time.perf_counter()
+        try:
+            factor = self._released_backend.factorize(Kt)
+        except SingularMatrixError:
+            return None
+        finally:
+            self.timer.factorize += time.perf_counter() - t0
+            self.timer.n_factorizations += 1
+        neg = getattr(factor, "negative_pivots", None)
+        return neg() if neg is not None else None
 
     # ---------------------------------------------------------------- solve
     def solve(

@@ -25,6 +25,7 @@ import logging
 from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
 
 from barhinge._protocols import SolverModel
 from barhinge.actuators import Actuators
@@ -68,14 +69,19 @@ def fold_weights(model: SolverModel) -> tuple[np.ndarray, float]:
 
 def _node_coordinates(model: SolverModel, V: np.ndarray) -> np.ndarray:
     """(n_nodes, 3) model nodes from pattern vertices ``V``: centre nodes at the mean of
-    their face's corners."""
+    their face's corners. ``V`` may hold many states, (n_states, n_vertices, 3)."""
+    V = np.asarray(V, dtype=float)
     cp = model.pattern
-    n = int(model.n_nodes)
-    if n == cp.n_vertices:
+    if int(model.n_nodes) == cp.n_vertices:
         return V.copy()
     centre_face = triangulate(cp, model.scheme).centre_face
-    C = np.stack([V[list(cp.faces[f])].mean(axis=0) for f in centre_face])
-    return np.vstack([V, C])
+    corners = [cp.faces[f] for f in centre_face]
+    sizes = np.fromiter((len(c) for c in corners), dtype=np.int64, count=len(corners))
+    cols = np.fromiter((i for c in corners for i in c), dtype=np.int64, count=int(sizes.sum()))
+    rows = np.repeat(np.arange(len(corners)), sizes)
+    mean = sp.csr_matrix((1.0 / sizes[rows], (rows, cols)), shape=(len(corners), cp.n_vertices))
+    C = np.stack([mean @ v for v in V]) if V.ndim == 3 else mean @ V
+    return np.concatenate([V, C], axis=-2)
 
 
 def _fit_supports(X: np.ndarray, fixed: np.ndarray, target: np.ndarray) -> np.ndarray:
@@ -194,7 +200,7 @@ def rigid_guide(
             why.append(f"{'triangulated' if triangulated else 'rigid'} panels: {exc}")
             continue
         fx, ft = np.asarray(fixed, bool), np.asarray(fixed_target, float)
-        X = np.stack([_fit_supports(_node_coordinates(model, V), fx, ft) for V in path.X])
+        X = np.stack([_fit_supports(Xs, fx, ft) for Xs in _node_coordinates(model, path.X)])
         meta = path.meta
         record = {
             "predictor": "triangulated panels" if triangulated else "rigid panels",

@@ -48,11 +48,16 @@ def _vm_scene(steps: int = 20, factor: float = 1.5, **opts) -> Scene:
 
 
 # ------------------------------------------------------------------ inertia
+@pytest.mark.parametrize("route", ["haynsworth", "released factor"])
 @pytest.mark.parametrize("name", available_backends())
-def test_released_inertia_from_the_bordered_factorisation_matches_dense(name):
+def test_released_inertia_from_the_bordered_factorisation_matches_dense(name, route, monkeypatch):
     """neg(K_t) = neg([K_t G^T; G 0]) - neg(Y), Y the multiplier block of the inverse
-    (Haynsworth): checked on a Miura tangent shifted to 0, 3, 7 and 11 negative
-    eigenvalues."""
+    (Haynsworth), or (many actuators) the pivots of a factorisation of K_t itself: both
+    checked on a Miura tangent shifted to 0, 3, 7 and 11 negative eigenvalues."""
+    from barhinge.solver import bordered
+
+    min_act = 1 if route == "released factor" else 10**9
+    monkeypatch.setattr(bordered, "RELEASED_FACTOR_MIN_ACT", min_act)
     cp = bh.families.miura(2, 2, alpha=60.0, fold=30.0)
     model = BarHingeModel.from_pattern(cp, "N5B8", fold_stiffness=0.1, bar_EA=1e3)
     edges = miura_line_creases(cp)
@@ -73,6 +78,10 @@ def test_released_inertia_from_the_bordered_factorisation_matches_dense(name):
         sysm.factorize((K - shift * sp.identity(K.shape[0])).tocsr(), terms, mu, penalty=50.0)
         got = sysm.tangent_negative_eigenvalues()
         assert got == int(np.sum(w < shift)) == n_neg, (name, n_neg, got)
+        # the bordered (saddle-point) factorisation takes the released factor's route
+        took = sysm._released_backend is not None
+        saddle = getattr(sysm.backend, "saddle_point", False)
+        assert took == (route == "released factor" and saddle), name
 
 
 def test_stability_check_option_is_validated():
