@@ -322,27 +322,36 @@ class RigidConstraints:
         A : (n_cv, D, 3) float
             Axis of each crease slot in the vertex frame (``a_k = T_{k-1} e_x``).
         """
-        nv, D = self.loop_var.shape
-        r = np.where(self.loop_var >= 0, rho[np.maximum(self.loop_var, 0)], 0.0)
-        cr, sr = np.cos(r)[:, :, None], np.sin(r)[:, :, None]
-        ca, sa = (x[:, :, None] for x in self._cs_alpha)
+        FT, AT = self._loop_products_t(rho)
+        return FT.transpose(2, 0, 1), AT.transpose(2, 0, 1)
+
+    @cached_property
+    def _loop_t(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(loop_var, its validity, cos alpha, sin alpha), each (D, n_cv) contiguous."""
+        lv = np.ascontiguousarray(self.loop_var.T)
+        ca, sa = self._cs_alpha
+        return lv, lv >= 0, np.ascontiguousarray(ca.T), np.ascontiguousarray(sa.T)
+
+    def _loop_products_t(self, rho: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`loop_products` with the vertex index last: F (3, 3, n_cv), A (D, 3, n_cv)
+        (contiguous rows of length n_cv: the products run on whole rows)."""
+        lv, valid, ca, sa = self._loop_t
+        D, nv = lv.shape
+        r = np.where(valid, rho[np.maximum(lv, 0)], 0.0)
+        cr, sr = np.cos(r), np.sin(r)
         # columns of the running product F, updated by F <- F Rx(rho_j) Rz(alpha_j)
-        c0 = np.zeros((nv, 3))
-        c1 = np.zeros((nv, 3))
-        c2 = np.zeros((nv, 3))
-        c0[:, 0] = c1[:, 1] = c2[:, 2] = 1.0
-        A = np.empty((nv, D, 3))
+        c0, c1, c2 = np.zeros((3, nv)), np.zeros((3, nv)), np.zeros((3, nv))
+        c0[0] = c1[1] = c2[2] = 1.0
+        A = np.empty((D, 3, nv))
         for j in range(D):
-            A[:, j] = c0
-            c1, c2 = c1 * cr[:, j] + c2 * sr[:, j], c2 * cr[:, j] - c1 * sr[:, j]
-            c0, c1 = c0 * ca[:, j] + c1 * sa[:, j], c1 * ca[:, j] - c0 * sa[:, j]
-        F = np.stack([c0, c1, c2], axis=2)
-        return F, A
+            A[j] = c0
+            c1, c2 = c1 * cr[j] + c2 * sr[j], c2 * cr[j] - c1 * sr[j]
+            c0, c1 = c0 * ca[j] + c1 * sa[j], c1 * ca[j] - c0 * sa[j]
+        return np.stack([c0, c1, c2], axis=1), A
 
     def residual(self, rho: np.ndarray) -> np.ndarray:
         """(3 n_cv,) closure residual ``vee(skew(F))`` per vertex (zero when closed)."""
-        F, _ = self.loop_products(rho)
-        return _vee_skew(F).ravel()
+        return self.closure(rho)[0]
 
     def closure_error(self, rho: np.ndarray) -> np.ndarray:
         """(n_cv,) Frobenius norm of ``F - I`` at each vertex (also detects a 180 deg loop)."""
@@ -356,15 +365,26 @@ class RigidConstraints:
 
     def evaluate_full(self, rho: np.ndarray) -> tuple[np.ndarray, sp.csr_matrix, np.ndarray]:
         """Residual, Jacobian and the loop products F (n_cv, 3, 3) at ``rho``."""
-        F, A = self.loop_products(rho)
-        r = _vee_skew(F).ravel()
+        r, products = self.closure(rho)
+        return r, self.jacobian_of(products), products[0].transpose(2, 0, 1)
+
+    def closure(self, rho: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
+        """Residual (3 n_cv,) at ``rho`` and the loop products it came from (the input of
+        :meth:`jacobian_of`, so that the Jacobian is built only where it is needed)."""
+        FT, AT = self._loop_products_t(rho)
+        r = 0.5 * np.stack([FT[2, 1] - FT[1, 2], FT[0, 2] - FT[2, 0], FT[1, 0] - FT[0, 1]], 1)
+        return r.ravel(), (FT, AT)
+
+    def jacobian_of(self, products: tuple[np.ndarray, np.ndarray]) -> sp.csr_matrix:
+        """(3 n_cv, n_var) exact sparse Jacobian from the loop products of :meth:`closure`:
+        ``dr_v / drho_k = G_v a_k`` with ``G = (tr F I - F) / 2``."""
+        FT, AT = products
+        F = FT.transpose(2, 0, 1)
         tr = np.trace(F, axis1=1, axis2=2)
         G = 0.5 * (tr[:, None, None] * np.eye(3) - F)  # (nv, 3, 3)
-        cols = A @ np.swapaxes(G, 1, 2)  # (nv, D, 3): cols[v, d] = G[v] @ A[v, d]
+        cols = AT.transpose(2, 0, 1) @ np.swapaxes(G, 1, 2)  # cols[v, d] = G[v] @ A[v, d]
         indptr, indices, order, vmask = self._pattern_csr
-        data = cols[vmask][order]
-        J = sp.csr_matrix((data, indices, indptr), shape=(self.n_eq, self.n_var))
-        return r, J, F
+        return sp.csr_matrix((cols[vmask][order], indices, indptr), shape=(self.n_eq, self.n_var))
 
     def jacobian(self, rho: np.ndarray) -> sp.csr_matrix:
         """(3 n_cv, n_var) exact sparse Jacobian ``dr/drho``."""

@@ -275,7 +275,8 @@ class RigidSolver:
         (quadratic) for the price of one factorisation per step."""
         tol = self.opt.tol
         hist: list[float] = []
-        r, J, F = self.rc.evaluate_full(rho)
+        rc = self.rc
+        r, products = rc.closure(rho)  # the Jacobian only where an iteration follows
         for it in range(self.opt.max_iter + 1):
             res = float(np.max(np.abs(r), initial=0.0))
             hist.append(res)
@@ -283,13 +284,15 @@ class RigidSolver:
                 return rho, hist, False
             if res <= tol:
                 # |F - I| also rejects the spurious 180-degree loops where r = 0
-                if len(F) == 0 or float(np.abs(F - np.eye(3)).max()) <= 100 * tol:
+                FT = products[0]
+                if FT.shape[2] == 0 or float(np.abs(FT - np.eye(3)[:, :, None]).max()) <= 100 * tol:
                     return rho, hist, True
                 return rho, hist, False
             if it == self.opt.max_iter:
                 break
             if len(hist) >= 3 and res > 2.0 * hist[-2]:
                 return rho, hist, False  # diverging
+            J = rc.jacobian_of(products)
             # forcing term: inexact Newton stays (nearly) quadratic with eta ~ |r|
             eta = float(np.clip(10.0 * res, 1e-10, 1e-2))
             if it == 0:
@@ -304,11 +307,11 @@ class RigidSolver:
                 step *= 0.5 / smax
             n0 = float((r * r).sum())  # backtrack on |r|_2 (Gauss-Newton descends it)
             for _ in range(6):
-                r_t, J_t, F_t = self.rc.evaluate_full(rho + step)
+                r_t, p_t = rc.closure(rho + step)
                 if float((r_t * r_t).sum()) < n0:
                     break
                 step *= 0.5
-            rho, r, J, F = rho + step, r_t, J_t, F_t
+            rho, r, products = rho + step, r_t, p_t
             self.iterations += 1
         return rho, hist, False
 
