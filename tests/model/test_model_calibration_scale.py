@@ -97,3 +97,21 @@ def test_skewed_strip_softens_under_refinement_towards_the_beam() -> None:
     # meets the difference between the clamped strip and the beam's plane sections
     assert np.all(excess[1:4] / excess[:3] < 0.5), ratio
     assert excess[-1] < 0.05, ratio
+
+
+@pytest.mark.parametrize("bend", ["plate", "kirchhoff", "filipov"])
+@pytest.mark.parametrize("scheme", ["N5B8", "N4B5"])
+def test_hinge_stiffness_scales_exactly_with_the_units(bend: str, scheme: str) -> None:
+    """Bending and fold hinges store a moment per radian ~ D ~ E t^3: drawn at scale s
+    (lengths and thickness), every hinge stiffness scales by s^3 (the plate rule through its
+    Morley solve per panel shape, to that solve's round-off)."""
+    ref = None
+    for s in (1e-3, 1.0, 1e3):
+        cp = skewed_strip(3, 2, 60.0, a=s)
+        model = BarHingeModel.from_pattern(
+            cp, scheme, Material(E=E, nu=NU, t=T * s), bend_calibration=bend
+        )
+        k = np.asarray(model.hinge_k) / s**3
+        if ref is None:
+            ref = k
+        np.testing.assert_allclose(k, ref, rtol=1e-8)
