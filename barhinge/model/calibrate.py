@@ -63,7 +63,8 @@ BEND_COEFFICIENT_F17 = 0.55
 #: lower bound of a bar area in the fit, as a fraction of t * face area / total bar length
 #: (keeps every bar load-bearing, so no in-plane mechanism appears; see docs/calibration.md)
 MIN_AREA_FRACTION = 0.1
-#: relative weight of the ridge that picks the smallest of equally good bounded bar fits
+#: weight of the ridge that picks the smallest of equally good bounded bar fits, relative to
+#: the weakest direction the moduli fix
 BOUNDED_FIT_RIDGE = 1.0e-8
 #: weight of the dilation row of the ``"dilation"`` bar calibration (relative to the six
 #: moduli rows): the row's residual is ~ 1/weight^2 of the others'
@@ -182,9 +183,9 @@ def _bounded_fits(G: np.ndarray, y: np.ndarray, a_min: np.ndarray) -> np.ndarray
     millimetres or metres gets the same bar stiffnesses ``E A / L`` per unit thickness. Where
     several area sets fit equally well (more bars than moduli), the smallest one is taken
     (a ridge of weight ``BOUNDED_FIT_RIDGE`` relative to the weakest direction the moduli
-    fix), the bounded counterpart of the
-    minimum-norm ``pinv`` fit used where no bound is active. Faces of the same shape are
-    solved once (keyed on the rounded dimensionless problem)."""
+    fix), the bounded counterpart of the minimum-norm ``pinv`` fit used where no bound is
+    active. Faces of the same shape are solved once (keyed on the rounded dimensionless
+    problem)."""
     from scipy.optimize import lsq_linear  # lazy: scipy.optimize costs ~0.15 s to import
 
     y_scale = np.abs(y).max(axis=1)

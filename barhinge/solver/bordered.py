@@ -500,8 +500,9 @@ class BorderedSystem:
             return False
         self._record_inertia(na)  # inertia(KKT) = inertia(A) + inertia(-S), S > 0 when A > 0
         self._keep(_KKTSolver(self.factor, self.Gf, self.penalty), t_start)
-        ok = self._blk_ok and self._penalty_blocks is not None and self._data_full is not None
-        self._released = (self._data_full, self._penalty_blocks) if ok else None  # type: ignore[assignment]
+        self._released = None
+        if self._blk_ok and self._penalty_blocks is not None and self._data_full is not None:
+            self._released = (self._data_full, self._penalty_blocks)
         return True
 
     def _released_inertia(self) -> int | None:
