@@ -200,8 +200,15 @@ def _child(args: list[str]) -> dict:
             print(line, end="", file=sys.stderr, flush=True)
     out = proc.stdout.read()
     if proc.wait() != 0:
-        tail = "".join(err[-5:]).strip()
-        raise RuntimeError(f"size run {' '.join(args)} failed (exit {proc.returncode}): {tail}")
+        # the child's own last words, without what ``time -v`` adds
+        text = "".join(err).split("\tCommand being timed:")[0]
+        own = [ln for ln in text.strip().splitlines() if not ln.startswith("Command ")]
+        why = own[-1].strip() if own else "no message"
+        code = proc.returncode
+        signal = re.search(r"^Command terminated by signal (\d+)", text, re.M)
+        if signal or code < 0:
+            why = f"killed by signal {signal.group(1) if signal else -code}; {why}"
+        raise RuntimeError(f"size run {' '.join(args)} failed (exit {code}): {why}")
     row = json.loads(out.strip().splitlines()[-1])
     row.update(_time_v("".join(err)) if timer is not None else {})
     return row
@@ -360,12 +367,18 @@ def main() -> None:
         print(json.dumps(pieces(a.one_pieces)))
         return
 
-    rows = []
+    rows, failed = [], []
     for mat in a.materials:
         for n in a.sizes if mat == "quasi-rigid" else a.compliant_sizes:
-            rows.append(_child(["--one", str(n), "--steps", str(a.steps), "--material", mat]))
+            try:
+                rows.append(_child(["--one", str(n), "--steps", str(a.steps), "--material", mat]))
+            except RuntimeError as exc:  # the other sizes still run and are published
+                print(f"error: n = {n}, {mat}: {exc}", file=sys.stderr, flush=True)
+                failed.append(f"n = {n}, {mat}: {exc}")
+                continue
             print(fold_table(rows, a.steps)[-1], flush=True)
     lines = fold_table(rows, a.steps) + exponent_lines(rows)
+    lines += [f"\n**Not completed**: {f}" for f in failed]
     for n in a.pieces:
         big = _child(["--one-pieces", str(n)])
         lines += pieces_lines(big, rows, a.steps) + ten_million_lines(big, rows, a.steps)
@@ -387,6 +400,8 @@ def main() -> None:
         doc = HERE.parent / "docs" / "solver-performance.md"
         body = "\n".join([generated_stamp(cmd), "", *lines])
         write_between(doc, "<!-- scaling:start -->", "<!-- scaling:end -->", body)
+    if failed:
+        sys.exit(f"error: {len(failed)} size(s) did not complete (see above)")
 
 
 if __name__ == "__main__":
