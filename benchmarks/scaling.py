@@ -10,13 +10,13 @@ N5B8, quasi-rigid stiffness set, actuators on the middle crease line, flat -> 60
 iterations, factorisations, seconds per factorisation-iteration, peak memory. The exponent
 ``p`` of ``wall ~ DOF^p`` is the least-squares slope on log-log axes over the sizes run.
 
-``--sizes ... 200`` folds the million-DOF sheet in full like the others (about half an hour
-on a 2-core machine, ~9 GB). ``--pieces N`` measures, for a large sheet n = N, only the
-pieces that fit a short run: model build, the first assembly of the tangent (with the
-process's peak memory after it), and one Newton iteration's factorisation + solve at the flat
-state; where that sheet is not folded in full, the whole fold is *extrapolated* (stated as
-such in the table) from the measured per-iteration time times the iterations per step of the
-largest size run in full.
+``--sizes ... 200`` folds the million-DOF sheet in full like the others (about an hour
+on a 2-core machine, ~12 GB); every size prints its steps on stderr as it goes.
+``--pieces N`` measures, for a large sheet n = N, only the pieces that fit a short run:
+model build, the first assembly of the tangent (with the process's peak memory after it),
+and one Newton iteration's factorisation + solve at the flat state; where that sheet is not
+folded in full, the whole fold is *extrapolated* (stated as such in the table) from the
+measured per-iteration time times the iterations per step of the largest size run in full.
 
 ``--publish`` writes the tables into docs/solver-performance.md (between the ``scaling``
 markers), using :func:`barhinge._publish.write_between`.
@@ -71,7 +71,18 @@ def one(n: int, steps: int, material: str) -> dict:
     sc = miura_scene(n, 0.0, steps, material=material)
     build = time.perf_counter() - t0
     c0, t0 = time.process_time(), time.perf_counter()
-    path = bh.solve(sc)
+
+    def progress(done: int, total: int, value: float) -> None:
+        # live per-step line on stderr: a long fold (the 200 x 200 sheet) shows where it is
+        print(
+            f"[n={n} {material}] step {done}/{total}  t={value:.3f}  "
+            f"wall {time.perf_counter() - t0:.0f} s  CPU {time.process_time() - c0:.0f} s  "
+            f"peak {_peak_mb():.0f} MB",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    path = bh.solve(sc, progress=progress)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     tm = path.meta["timing"]
     its = int(path.meta["newton"]["total_iterations"])
@@ -174,13 +185,32 @@ def _time_v(stderr: str) -> dict:
 
 
 def _child(args: list[str]) -> dict:
+    """Run one size in a fresh process (under ``time -v`` where it exists), echoing its
+    per-step progress lines live; its row, with the whole-process figures."""
     cmd = [sys.executable, __file__, *args]
     timer = shutil.which("time") or ("/usr/bin/time" if Path("/usr/bin/time").exists() else None)
     if timer is not None:
         cmd = [timer, "-v", *cmd]
-    run = subprocess.run(cmd, capture_output=True, text=True, check=True)
-    row = json.loads(run.stdout.strip().splitlines()[-1])
-    row.update(_time_v(run.stderr) if timer is not None else {})
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert proc.stderr is not None and proc.stdout is not None
+    err = []
+    for line in proc.stderr:
+        err.append(line)
+        if line.startswith("[n="):
+            print(line, end="", file=sys.stderr, flush=True)
+    out = proc.stdout.read()
+    if proc.wait() != 0:
+        # the child's own last words, without what ``time -v`` adds
+        text = "".join(err).split("\tCommand being timed:")[0]
+        own = [ln for ln in text.strip().splitlines() if not ln.startswith("Command ")]
+        why = own[-1].strip() if own else "no message"
+        code = proc.returncode
+        signal = re.search(r"^Command terminated by signal (\d+)", text, re.M)
+        if signal or code < 0:
+            why = f"killed by signal {signal.group(1) if signal else -code}; {why}"
+        raise RuntimeError(f"size run {' '.join(args)} failed (exit {code}): {why}")
+    row = json.loads(out.strip().splitlines()[-1])
+    row.update(_time_v("".join(err)) if timer is not None else {})
     return row
 
 
@@ -337,12 +367,18 @@ def main() -> None:
         print(json.dumps(pieces(a.one_pieces)))
         return
 
-    rows = []
+    rows, failed = [], []
     for mat in a.materials:
         for n in a.sizes if mat == "quasi-rigid" else a.compliant_sizes:
-            rows.append(_child(["--one", str(n), "--steps", str(a.steps), "--material", mat]))
+            try:
+                rows.append(_child(["--one", str(n), "--steps", str(a.steps), "--material", mat]))
+            except RuntimeError as exc:  # the other sizes still run and are published
+                print(f"error: n = {n}, {mat}: {exc}", file=sys.stderr, flush=True)
+                failed.append(f"n = {n}, {mat}: {exc}")
+                continue
             print(fold_table(rows, a.steps)[-1], flush=True)
     lines = fold_table(rows, a.steps) + exponent_lines(rows)
+    lines += [f"\n**Not completed**: {f}" for f in failed]
     for n in a.pieces:
         big = _child(["--one-pieces", str(n)])
         lines += pieces_lines(big, rows, a.steps) + ten_million_lines(big, rows, a.steps)
@@ -364,6 +400,8 @@ def main() -> None:
         doc = HERE.parent / "docs" / "solver-performance.md"
         body = "\n".join([generated_stamp(cmd), "", *lines])
         write_between(doc, "<!-- scaling:start -->", "<!-- scaling:end -->", body)
+    if failed:
+        sys.exit(f"error: {len(failed)} size(s) did not complete (see above)")
 
 
 if __name__ == "__main__":
