@@ -77,13 +77,9 @@ else:
 
 
 def support_sets(cp, flat_xy: np.ndarray, axis: int) -> tuple[np.ndarray, np.ndarray]:
-    """(supported vertex ids, pattern edges joining two of them): the study's supports."""
-    c = flat_xy[:, axis]
-    tol = 1e-6 * float(np.ptp(c))
-    sv = np.flatnonzero((c <= c.min() + tol) | (c >= c.max() - tol))
-    E = np.asarray(cp.edges)
-    se = np.flatnonzero(np.isin(E[:, 0], sv) & np.isin(E[:, 1], sv))
-    return sv, se
+    """(supported vertex ids, supported pattern edges): the study's two line supports
+    (:func:`roofs.support_lines`)."""
+    return roofs.support_lines(cp, flat_xy, axis)
 
 
 def crease_stiffness_per_length(model) -> float:
