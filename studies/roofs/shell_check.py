@@ -649,7 +649,7 @@ def prose(results: list[dict], plate: dict) -> str:
                 f"(m = {r['bar_hinge'][v][-1]['m']}: {_pct(r['errors'][v][-1])})"
                 for r in settled
                 if r not in within
-                for v in VARIANTS
+                for v in CONSISTENT  # the rules that converge to the plate
                 if v != MAIN_RULE and abs(r["errors"][v][-1]) <= 0.05
             )
             + ". Where the shell's own refinement converges slowly or not monotonically "
