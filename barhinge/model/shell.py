@@ -106,23 +106,19 @@ class ShellModel:
         self, f: np.ndarray, fixed_nodes: np.ndarray, fixed_dofs: np.ndarray | None = None
     ) -> np.ndarray:
         """(n_dof,) linear displacements under ``f`` with the translations of
-        ``fixed_nodes`` held (pinned) and the DOFs ``fixed_dofs`` held too."""
-        import scipy.sparse.linalg as spla
+        ``fixed_nodes`` held (pinned) and the DOFs ``fixed_dofs`` held too. The sparse
+        factorisation is the package's linear backend (:func:`barhinge.linalg.get_backend`:
+        PARDISO where it installs, else SuperLU)."""
+        from barhinge.linalg.backends import SingularMatrixError, get_backend
 
         fixed = (3 * np.asarray(fixed_nodes, np.int64)[:, None] + np.arange(3)).ravel()
         if fixed_dofs is not None:
             fixed = np.union1d(fixed, np.asarray(fixed_dofs, np.int64))
         free = np.setdiff1d(np.arange(self.n_dof), fixed)
-        Kff = sp.csc_matrix(self.K[free][:, free])
+        Kff = sp.csr_matrix(self.K[free][:, free])
         try:
-            lu = spla.splu(
-                Kff,
-                permc_spec="MMD_AT_PLUS_A",
-                diag_pivot_thresh=0.0,
-                options={"SymmetricMode": True},
-            )
-            uf = lu.solve(np.asarray(f, float)[free])
-        except RuntimeError as exc:
+            uf = get_backend("auto").factorize(Kff).solve(np.asarray(f, float)[free])
+        except SingularMatrixError as exc:
             raise ConfigError("shell model: the supports leave a mechanism") from exc
         if not np.all(np.isfinite(uf)):
             raise ConfigError("shell model: the supports leave a mechanism")

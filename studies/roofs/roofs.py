@@ -5,8 +5,9 @@ Common specification (module constants): span ``SPAN`` between two supported edg
 sheet (``MATERIAL``, ``DENSITY``), uniform load ``Q`` per unit plan area, downwards. Each
 pattern spans in its structural direction: Miura-ori sheets and corrugations along their
 ridges (y), the Yoshimura arch and the arched Miura across their arch (x), the Ron Resch and
-waterbomb textures along x. The supported edges are the sheet's two boundary lines across the
-span (vertices at the flat pattern's extreme coordinate along the span), pinned (x, y, z fixed).
+waterbomb textures along x. The supported edges are the sheet's two ends across the span
+(:func:`support_lines`: the boundary between the vertices at the flat pattern's extreme
+coordinate along the span, following a jagged end), pinned (x, y, z fixed).
 
 Folded states
 -------------
@@ -254,12 +255,57 @@ def folded(family: str, state: float, **override):
 
 
 # ------------------------------------------------------------------------------ analysis
-def supports(model, flat_xy: np.ndarray, axis: int, dofs: str = "xyz") -> np.ndarray:
-    """(n_nodes, 3) bool: the vertices at the flat pattern's min and max coordinate along the
-    span axis, fixed in ``dofs``."""
+def support_lines(cp, flat_xy: np.ndarray, axis: int) -> tuple[np.ndarray, np.ndarray]:
+    """(vertex ids, edge ids) of the two supported edges of the sheet: at each end of the span,
+    the sheet's boundary between its outermost vertices.
+
+    The outermost vertices are those at the flat pattern's min and max coordinate along
+    ``axis``. Where an end of the sheet is straight they are joined by boundary edges; where
+    it is jagged (the arched Miura's zig-zag feet, the Ron Resch texture's edge) the boundary
+    arcs between consecutive outermost vertices at the same end are supported too, so that
+    every roof sits on two line supports, never on isolated points (a pinned point of a
+    membrane concentrates its reaction and its strain energy diverges under refinement).
+    """
     c = flat_xy[:, axis]
     tol = 1e-6 * float(np.ptp(c))
-    ids = np.flatnonzero((c <= c.min() + tol) | (c >= c.max() - tol))
+    end = np.where(c <= c.min() + tol, 1, np.where(c >= c.max() - tol, 2, 0))
+    E = np.asarray(cp.edges)
+    bd = np.flatnonzero(np.asarray(cp.assignment) == "B")
+    nxt: dict[int, list[int]] = {}
+    for e in bd.tolist():
+        a, b = (int(v) for v in E[e])
+        nxt.setdefault(a, []).append(e)
+        nxt.setdefault(b, []).append(e)
+    if any(len(es) != 2 for es in nxt.values()):
+        raise ValueError("supports: the sheet's boundary is not one simple loop")
+    # walk the boundary loop once from an outermost vertex: (vertex, edge to the next one)
+    start = int(np.flatnonzero(end)[0])
+    loop_v, loop_e, v, prev = [], [], start, -1
+    while True:
+        e = next(x for x in nxt[v] if x != prev)
+        loop_v.append(v)
+        loop_e.append(e)
+        v = int(E[e, 1] if E[e, 0] == v else E[e, 0])
+        prev = e
+        if v == start:
+            break
+    if len(loop_e) != len(bd):
+        raise ValueError("supports: the sheet's boundary is not one simple loop")
+    ends = np.flatnonzero(end[loop_v])
+    sv, se = set(np.flatnonzero(end).tolist()), []
+    for i, j in zip(ends, np.append(ends[1:], ends[0] + len(loop_v)), strict=True):
+        if end[loop_v[i]] != end[loop_v[j % len(loop_v)]]:
+            continue  # a side of the sheet, from one end to the other
+        arc = [(i + k) % len(loop_v) for k in range(j - i)]
+        se += [loop_e[k] for k in arc]
+        sv.update(loop_v[k] for k in arc)
+    return np.array(sorted(sv), np.int64), np.array(sorted(se), np.int64)
+
+
+def supports(model, flat_xy: np.ndarray, axis: int, dofs: str = "xyz") -> np.ndarray:
+    """(n_nodes, 3) bool: the vertices of the two supported edges (:func:`support_lines`),
+    fixed in ``dofs``."""
+    ids, _ = support_lines(model.pattern, flat_xy, axis)
     S = np.zeros((model.n_nodes, 3), bool)
     S[np.ix_(ids, ["xyz".index(d) for d in dofs])] = True
     return S

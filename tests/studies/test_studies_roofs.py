@@ -136,3 +136,32 @@ def test_every_roof_states_its_stability(study) -> None:
     for r in study.RESULTS:
         if not study.stable(r):
             assert f"- {r['family']} {r['state']:g}:" in text
+
+
+def test_every_roof_sits_on_two_line_supports(study) -> None:
+    """The supports are the two ends of the sheet as lines (`roofs.support_lines`), never
+    isolated points: the supported edges form two chains, one per end, each through all the
+    outermost vertices of its end and nothing beyond the supported vertices."""
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import connected_components
+
+    roofs = study.roofs
+    for fam, spec in roofs.FAMILIES.items():
+        cp, flat_xy, _ = roofs.folded(fam, spec["states"][0])
+        sv, se = roofs.support_lines(cp, flat_xy, spec["axis"])
+        E = np.asarray(cp.edges)[se]
+        assert set(np.asarray(cp.assignment)[se]) == {"B"}, fam
+        assert set(E.ravel()) == set(sv.tolist()), fam  # every supported vertex on a line
+        n = cp.n_vertices
+        G = sp.coo_matrix((np.ones(len(E)), (E[:, 0], E[:, 1])), shape=(n, n))
+        _, lab = connected_components(G, directed=False)
+        chains = {int(lab[v]) for v in sv}
+        assert len(chains) == 2, fam
+        c = flat_xy[:, spec["axis"]]
+        tol = 1e-6 * np.ptp(c)
+        for outer in (np.flatnonzero(c <= c.min() + tol), np.flatnonzero(c >= c.max() - tol)):
+            assert len({int(lab[v]) for v in outer}) == 1, fam  # one chain per end
+            assert np.isin(outer, sv).all(), fam
+        # a chain is a path: as many edges as vertices less one
+        for k in chains:
+            assert (lab[E[:, 0]] == k).sum() == (lab[sv] == k).sum() - 1, fam

@@ -47,3 +47,22 @@ def test_flat_plate_shell_approaches_navier(study) -> None:
     r = [s["ratio"] for s in study.PLATE["shell"]]
     assert r[0] < r[1] < 1.0
     assert r[-1] > 0.9
+
+
+def test_membrane_bending_split(study) -> None:
+    """The split's variants scale one part of the sheet as stated (membrane E t or plate
+    E t^3 times ``STIFFENED``, the other kept), and a linear model whose stiffness matrix
+    only grows (K + (s - 1) K_part, K_part positive semi-definite) cannot get softer: every
+    variant is at least as stiff as the sheet at every level."""
+    mats = study.split_materials()
+    sheet = mats["sheet"]
+    s = study.STIFFENED
+    mem, pla = mats["stiff membranes"], mats["stiff plates"]
+    assert mem.E * mem.t == pytest.approx(s * sheet.E * sheet.t, rel=1e-12)
+    assert mem.E * mem.t**3 == pytest.approx(sheet.E * sheet.t**3, rel=1e-12)
+    assert pla.E * pla.t == pytest.approx(sheet.E * sheet.t, rel=1e-12)
+    assert pla.E * pla.t**3 == pytest.approx(s * sheet.E * sheet.t**3, rel=1e-12)
+    split = study.PLATE["split"]
+    k0 = split["sheet"]["stiffness"]
+    for name in ("stiff membranes", "stiff plates"):
+        assert all(k >= (1 - 1e-9) * ks for k, ks in zip(split[name]["stiffness"], k0, strict=True))
