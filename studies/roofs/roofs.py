@@ -270,7 +270,7 @@ def support_lines(cp, flat_xy: np.ndarray, axis: int) -> tuple[np.ndarray, np.nd
     tol = 1e-6 * float(np.ptp(c))
     end = np.where(c <= c.min() + tol, 1, np.where(c >= c.max() - tol, 2, 0))
     E = np.asarray(cp.edges)
-    bd = np.flatnonzero(np.asarray(cp.assignment) == "B")
+    bd = np.asarray(cp.boundary_edges)  # edges with one face
     nxt: dict[int, list[int]] = {}
     for e in bd.tolist():
         a, b = (int(v) for v in E[e])
