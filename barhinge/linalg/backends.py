@@ -265,6 +265,18 @@ class PardisoBackend:
         self._generation = 0
         self._fallback = SuperLUBackend()
 
+    def __del__(self) -> None:
+        # PARDISO keeps its factor and analysis in MKL's memory, which pypardiso never frees
+        # on its own: without this, every backend dropped leaks its factor (a study that
+        # solves many models ran out of memory). Its factors hold the backend, so it is
+        # only dropped with the last of them.
+        solver = getattr(self, "_solver", None)
+        if solver is not None:
+            try:
+                solver.free_memory(everything=True)
+            except Exception:  # interpreter shutdown: MKL may be unloaded already
+                pass
+
     def _upper(self, A: sp.spmatrix) -> sp.csr_matrix:
         """Upper triangle of A in CSR (explicit zeros kept), through a map built once per
         pattern. Every row must store its diagonal (PARDISO's rule for symmetric types)."""

@@ -2,8 +2,9 @@
 
 Every planar face (facet) of the pattern gets its own triangle mesh
 (:func:`barhinge.model.continuum.polygon_mesh`: a fan from the centroid refined ``refine``
-times, so every polygon edge is cut into ``2^refine`` equal segments and neighbouring facets
-share their nodes). On each facet, in its own plane frame ``(e1, e2, N)``:
+times, so every polygon edge is cut into ``2^refine`` segments, equal or, with ``grading``,
+shorter towards the corners; neighbouring facets share their nodes). On each facet, in its
+own plane frame ``(e1, e2, N)``:
 
 * **membrane**: plane-stress constant-strain triangles (vector P1 Lagrange,
   ``skfem.ElementVector(ElementTriP1())``), thickness ``t``;
@@ -137,7 +138,7 @@ class ShellModel:
         return np.union1d(np.flatnonzero(np.isin(self.node_edge, e)), ends)
 
 
-def _facet_local(P2: np.ndarray, material: Material, refine: int):
+def _facet_local(P2: np.ndarray, material: Material, refine: int, grading: float = 1.0):
     """Mesh and local matrices of one facet in its plane coordinates ``P2`` (k, 2)."""
     from skfem import (
         Basis,
@@ -148,7 +149,7 @@ def _facet_local(P2: np.ndarray, material: Material, refine: int):
     )
     from skfem.models.elasticity import linear_elasticity
 
-    mesh = polygon_mesh(P2, refine)
+    mesh = polygon_mesh(P2, refine, grading)
     E, nu, t = material.E, material.nu, material.t
     bm = Basis(mesh, ElementVector(ElementTriP1()))
     mu, lam = E / (2 * (1 + nu)), E * nu / (1 - nu * nu)
@@ -184,6 +185,7 @@ def shell_model(
     refine: int = 2,
     crease_stiffness: float | None = None,
     planarity_tol: float = 1e-6,
+    grading: float = 1.0,
 ) -> ShellModel:
     """Facet shell of the pattern ``cp`` at its state (module docstring).
 
@@ -199,6 +201,11 @@ def shell_model(
         ``None``: monolithic creases.
     planarity_tol : float
         Largest out-of-plane distance of a face's vertices, relative to its size.
+    grading : float
+        1: uniform facet meshes; ``p`` > 1: nodes concentrated at the facets' corners
+        (:func:`barhinge.model.continuum.polygon_mesh`; elements next to a corner
+        ``h^p`` long), for folded sheets whose stresses are singular at the pattern's
+        vertices.
     """
     from scipy.spatial import cKDTree
 
@@ -239,7 +246,7 @@ def shell_model(
         P2 = (P - P[0]) @ R[:2].T
         key = np.round(P2 / size, 10).tobytes()
         if key not in cache:
-            cache[key] = _facet_local(P2, mat, refine)
+            cache[key] = _facet_local(P2, mat, refine, grading)
         loc = cache[key]
         X3 = P[0] + loc["mesh"].p.T @ R[:2]  # (n_loc, 3)
         X3[: len(F)] = P  # corners exactly

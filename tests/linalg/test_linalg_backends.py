@@ -156,3 +156,40 @@ def test_pardiso_asks_mkl_for_reproducible_results(given, want):
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == want
+
+
+def _resident_mb() -> float:
+    """Resident memory of this process (Linux ``/proc/self/statm``), MB."""
+    import os
+
+    with open("/proc/self/statm") as fh:
+        return int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
+
+
+@needs_pardiso
+@pytest.mark.skipif(not __import__("os").path.exists("/proc/self/statm"), reason="Linux only")
+def test_pardiso_frees_its_factor_with_the_backend():
+    """MKL keeps PARDISO's factor in its own memory; a dropped backend must free it. A 2-D
+    Laplacian of 14 400 unknowns factorised by 12 fresh backends in turn: the process grows
+    by ~8 MB per factor when they leak, and by nothing once the first one is made."""
+    import gc
+
+    n = 120
+    T = sp.diags([-1.0, -1.0], [-1, 1], (n, n))
+    I = sp.identity(n)  # noqa: E741
+    A = (sp.kron(I, T) + sp.kron(T, I) + 4.01 * sp.identity(n * n)).tocsr()
+    b = np.ones(n * n)
+    get_backend("pardiso").factorize(A).solve(b)  # MKL's own start-up memory
+    gc.collect()
+    before = _resident_mb()
+    for _ in range(12):
+        x = get_backend("pardiso").factorize(A).solve(b)
+        gc.collect()
+    assert np.allclose(A @ x, b)
+    assert _resident_mb() - before < 30.0
+
+
+@needs_pardiso
+def test_a_pardiso_backend_that_never_factorised_is_dropped_quietly():
+    b = get_backend("pardiso")
+    del b
