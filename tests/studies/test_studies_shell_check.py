@@ -62,10 +62,12 @@ def test_membrane_bending_split(study) -> None:
     assert mem.E * mem.t**3 == pytest.approx(sheet.E * sheet.t**3, rel=1e-12)
     assert pla.E * pla.t == pytest.approx(sheet.E * sheet.t, rel=1e-12)
     assert pla.E * pla.t**3 == pytest.approx(s * sheet.E * sheet.t**3, rel=1e-12)
-    split = study.PLATE["split"]
-    k0 = split["sheet"]["stiffness"]
-    for name in ("stiff membranes", "stiff plates"):
-        assert all(k >= (1 - 1e-9) * ks for k, ks in zip(split[name]["stiffness"], k0, strict=True))
+    for split in (study.PLATE["split"], study.PLATE["sides"]):  # uniform and graded meshes
+        k0 = split["sheet"]["stiffness"]
+        for name in ("stiff membranes", "stiff plates"):
+            k = split[name]["stiffness"]
+            assert all(a >= (1 - 1e-9) * b for a, b in zip(k, k0, strict=True))
+    assert study.sides_finding(study.PLATE["sides"]).startswith("7. ")
 
 
 def test_extrapolation_refuses_a_sequence_outside_its_asymptotic_range(study) -> None:
