@@ -125,14 +125,23 @@ def parse_accuracy(text: str | float) -> float:
     return val
 
 
+#: observed orders below this are not extrapolated by :func:`richardson`: the correction
+#: would exceed ``1 / (2^p - 1)`` = 4.3 times the last change
+MIN_ORDER = 0.3
+
+
 def richardson(values: list[float]) -> tuple[float, float, float]:
     """(reference, observed rate p in m, |correction|) from values on m, 2m, 4m...:
     Richardson with ``p = log2(d1 / d2)`` of the last two differences when they shrink
-    monotonically; otherwise the finest value with the last change as its correction."""
+    monotonically; otherwise the finest value with the last change as its correction. A
+    sequence whose changes barely shrink (``p < MIN_ORDER``) is not in its asymptotic
+    range: the finest value with an unknown (infinite) correction."""
     if len(values) >= 3:
         d1, d2 = values[-2] - values[-3], values[-1] - values[-2]
         if d1 * d2 > 0 and abs(d2) < abs(d1):
             p = math.log2(d1 / d2)
+            if p < MIN_ORDER:
+                return values[-1], p, math.inf
             corr = d2 / (2.0**p - 1.0)
             return values[-1] + corr, p, abs(corr)
     if len(values) >= 2:

@@ -36,6 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
+from barhinge.analysis.accuracy import MIN_ORDER
+
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 import roofs  # noqa: E402
@@ -316,7 +318,7 @@ def poisson_check(levels_bh: list[int], levels_shell: list[int]) -> dict:
 
 
 #: observed orders below this are not extrapolated (:func:`extrapolate`)
-MIN_RATE = 0.3
+MIN_RATE = MIN_ORDER
 
 
 def extrapolate(k: list[float]) -> tuple[float, float, float]:
@@ -324,11 +326,7 @@ def extrapolate(k: list[float]) -> tuple[float, float, float]:
     (:func:`barhinge.analysis.accuracy.richardson`; one level: uncertainty NaN)."""
     from barhinge.analysis.accuracy import richardson
 
-    ref, p, unc = richardson(list(k))
-    if len(k) >= 3 and p < MIN_RATE:
-        # the correction would exceed 1 / (2^MIN_RATE - 1) = 4.3 times the last change:
-        # not in its asymptotic range, the finest value stands and its error is unknown
-        return float(k[-1]), p, float("inf")
+    ref, p, unc = richardson(list(k))  # below MIN_RATE: the finest value, unknown error
     return ref, p, unc if len(k) > 1 else float("nan")
 
 

@@ -7,6 +7,8 @@ solver.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -147,3 +149,16 @@ def test_cli_fold_accuracy(tmp_path, capsys):
     assert exc.value.code == 2
     err = capsys.readouterr().err
     assert "accuracy" in err and "Traceback" not in err
+
+
+def test_richardson_does_not_extrapolate_below_its_minimum_order():
+    """Changes that barely shrink (order 0.06: 1439, 1334, 1234) would extrapolate 17 times
+    the last change away, to a negative value; the finest value stands with an unknown
+    correction instead. Just above ``MIN_ORDER`` the power law is still recovered."""
+    from barhinge.analysis.accuracy import MIN_ORDER
+
+    ref, p, corr = richardson([1439.1, 1334.3, 1233.9])
+    assert p < MIN_ORDER and ref == 1233.9 and math.isinf(corr)
+    q = MIN_ORDER + 0.05
+    ref, p, corr = richardson([3 + 2 * m**-q for m in (4, 8, 16)])
+    assert ref == pytest.approx(3.0, rel=1e-12) and p == pytest.approx(q, rel=1e-12)
