@@ -59,9 +59,9 @@ def polygon_mesh(P: np.ndarray, refine: int = 3, grading: float = 1.0):
     ``grading`` > 1 concentrates the nodes at the polygon's corners (:func:`graded_points`):
     along every edge the node at fraction ``s`` moves to ``s^p / (s^p + (1 - s)^p)``, so
     the elements next to a corner are ``h^p`` long instead of ``h`` (a radical mesh of
-    exponent ``p``, the classical remedy for corner singularities of plates; Babuska &
-    Kellogg 1979). The edge nodes depend on the edge alone, so neighbouring polygons meshed
-    with the same ``refine`` and ``grading`` still share them."""
+    exponent ``p``, the classical remedy for corner singularities; Babuska, Kellogg &
+    Pitkaranta 1979, Numer. Math. 33, 447-471). The edge nodes depend on the edge alone, so
+    neighbouring polygons meshed with the same ``refine`` and ``grading`` still share them."""
     from skfem import MeshTri
 
     if not grading >= 1.0:
