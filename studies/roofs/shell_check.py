@@ -317,16 +317,12 @@ def poisson_check(levels_bh: list[int], levels_shell: list[int]) -> dict:
     return out
 
 
-#: observed orders below this are not extrapolated (:func:`extrapolate`)
-MIN_RATE = MIN_ORDER
-
-
 def extrapolate(k: list[float]) -> tuple[float, float, float]:
     """(reference, observed rate p in h, uncertainty) from values on levels h, h/2, h/4...
     (:func:`barhinge.analysis.accuracy.richardson`; one level: uncertainty NaN)."""
     from barhinge.analysis.accuracy import richardson
 
-    ref, p, unc = richardson(list(k))  # below MIN_RATE: the finest value, unknown error
+    ref, p, unc = richardson(list(k))  # below MIN_ORDER: the finest value, unknown error
     return ref, p, unc if len(k) > 1 else float("nan")
 
 
@@ -723,7 +719,7 @@ def prose(results: list[dict], plate: dict) -> str:
             )
             + ". Where the shell's own refinement converges slowly or not monotonically "
             "(rate below 1 or n/a) the reference is uncertain by the stated amount, below "
-            f"order {MIN_RATE:g} it is not extrapolated (the finest value, not settled), and "
+            f"order {MIN_ORDER:g} it is not extrapolated (the finest value, not settled), and "
             "the comparison is open.",
             f"6. **Why the Miura roofs converge slowly.** The shell of {split_label} "
             f"refined (r = {', '.join(str(r) for r in sp_levels)}): "

@@ -72,12 +72,12 @@ def test_membrane_bending_split(study) -> None:
 
 def test_extrapolation_refuses_a_sequence_outside_its_asymptotic_range(study) -> None:
     """Richardson on h, h/2, h/4: a sequence 1 + c 4^-r (order 2) extrapolates to its limit
-    1 exactly; one whose changes barely shrink (observed order below ``MIN_RATE``, here the
+    1 exactly; one whose changes barely shrink (observed order below ``MIN_ORDER``, here the
     graded Yoshimura shell's last levels, 1439, 1334, 1234 kN/m) is not extrapolated: the
     finest value stands with an unknown error, never a reference of the wrong sign."""
     ref, p, unc = study.extrapolate([1 + 3.0 * 4.0**-r for r in (1, 2, 3)])
     assert ref == pytest.approx(1.0, rel=1e-12) and p == pytest.approx(2.0, rel=1e-12)
     assert unc == pytest.approx(3.0 * 4.0**-3, rel=1e-12)  # the finest level's error
     ref, p, unc = study.extrapolate([1439.1, 1334.3, 1233.9])
-    assert p < study.MIN_RATE
+    assert p < study.MIN_ORDER
     assert ref == 1233.9 and math.isinf(unc)
