@@ -295,7 +295,71 @@ class RigidConstraints:
         order = np.lexsort((c, r))
         counts = np.bincount(r, minlength=self.n_eq)
         indptr = np.concatenate([[0], np.cumsum(counts)])
-        return indptr, c[order], order, vmask
+        idx = np.int32 if r.size < 2**31 else np.int64  # scipy's own choice: no copies
+        return indptr.astype(idx), c[order].astype(idx), order, vmask
+
+    @cached_property
+    def _jacobian_slots(self) -> np.ndarray:
+        """Position in ``data`` order of the Jacobian of each column entry ``(d, i, v)``
+        (loop slot, row, vertex; row-major): ``J.data = cols.ravel()[slots]``."""
+        _, _, order, vmask = self._pattern_csr
+        nv, D = self.loop_var.shape
+        flat = np.arange(D * 3 * nv).reshape(D, 3, nv).transpose(2, 0, 1)  # (nv, D, 3)
+        return flat[vmask][order]
+
+    @cached_property
+    def _normal_pattern(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Pattern of ``J^T J``, built once: (indptr, indices, valid slot pairs (D, D, n_cv),
+        their entries, the diagonal entries). Vertex ``v`` adds ``c_vd . c_ve`` (its Jacobian
+        columns of loop slots ``d``, ``e``) to the entry of the variables
+        ``(loop_var[v, d], loop_var[v, e])``; every diagonal entry is stored."""
+        n = self.n_var
+        lv = np.ascontiguousarray(self.loop_var.T)  # (D, n_cv)
+        pairs = (lv >= 0)[:, None, :] & (lv >= 0)[None, :, :]
+        keys = (lv[:, None, :] * n + lv[None, :, :])[pairs]
+        unique, slot = np.unique(
+            np.concatenate([keys, np.arange(n) * (n + 1)]), return_inverse=True
+        )
+        k_indptr = np.concatenate([[0], np.cumsum(np.bincount(unique // n, minlength=n))])
+        idx = np.int32 if unique.size < 2**31 else np.int64  # scipy's own choice: no copies
+        return (
+            k_indptr.astype(idx),
+            (unique % n).astype(idx),
+            pairs,
+            slot[: keys.size],
+            slot[keys.size :],
+        )
+
+    def normal_matrix(self, J: sp.csr_matrix) -> tuple[sp.csr_matrix, np.ndarray]:
+        """``J^T J`` (n_var, n_var) and the positions of its diagonal in ``data``.
+
+        For a Jacobian of this pattern (:meth:`jacobian_of`) the product is summed vertex by
+        vertex on a pattern that never changes, so that a sparse factorisation reuses its
+        ordering (4x faster than ``J.T @ J`` on a 70 x 70 Miura sheet); any other matrix
+        takes ``J.T @ J``."""
+        k_indptr, k_indices, pairs, slot, diag = self._normal_pattern
+        indptr, indices = self._pattern_csr[:2]
+        same = J.shape == (self.n_eq, self.n_var) and J.nnz == indices.size
+        if not (same and np.array_equal(J.indptr, indptr) and np.array_equal(J.indices, indices)):
+            K = (J.T @ J).tocsr()
+            K.setdiag(K.diagonal())  # store every diagonal entry
+            K.sort_indices()
+            rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
+            return K, np.flatnonzero(K.indices == rows)
+        D, nv = pairs.shape[1:]
+        cols = np.zeros(D * 3 * nv)
+        cols[self._jacobian_slots] = J.data
+        c = cols.reshape(D, 3, nv)
+        G = np.empty((D, D, nv))  # G[d, e] = c_d . c_e per vertex
+        for d in range(D):
+            for e in range(d, D):
+                G[d, e] = c[d, 0] * c[e, 0] + c[d, 1] * c[e, 1] + c[d, 2] * c[e, 2]
+                G[e, d] = G[d, e]
+        data = np.bincount(slot, weights=G[pairs], minlength=k_indices.size)
+        data = data.astype(float, copy=False)  # int when no vertex is constrained
+        K = sp.csr_matrix((data, k_indices, k_indptr), shape=(self.n_var, self.n_var))
+        K.has_sorted_indices = True
+        return K, diag
 
     # ------------------------------------------------------------------ evaluation
     @cached_property
@@ -378,13 +442,16 @@ class RigidConstraints:
     def jacobian_of(self, products: tuple[np.ndarray, np.ndarray]) -> sp.csr_matrix:
         """(3 n_cv, n_var) exact sparse Jacobian from the loop products of :meth:`closure`:
         ``dr_v / drho_k = G_v a_k`` with ``G = (tr F I - F) / 2``."""
-        FT, AT = products
-        F = FT.transpose(2, 0, 1)
-        tr = np.trace(F, axis1=1, axis2=2)
-        G = 0.5 * (tr[:, None, None] * np.eye(3) - F)  # (nv, 3, 3)
-        cols = AT.transpose(2, 0, 1) @ np.swapaxes(G, 1, 2)  # cols[v, d] = G[v] @ A[v, d]
-        indptr, indices, order, vmask = self._pattern_csr
-        return sp.csr_matrix((cols[vmask][order], indices, indptr), shape=(self.n_eq, self.n_var))
+        FT, AT = products  # (3, 3, n_cv), (D, 3, n_cv)
+        tr = FT[0, 0] + FT[1, 1] + FT[2, 2]
+        cols = np.empty_like(AT)  # cols[d, :, v] = G_v a_vd, on whole rows of n_cv
+        for i in range(3):
+            cols[:, i] = FT[i, 0] * AT[:, 0] + FT[i, 1] * AT[:, 1] + FT[i, 2] * AT[:, 2]
+        cols *= -0.5
+        cols += (0.5 * tr) * AT
+        indptr, indices = self._pattern_csr[:2]
+        data = cols.ravel()[self._jacobian_slots]
+        return sp.csr_matrix((data, indices, indptr), shape=(self.n_eq, self.n_var))
 
     def jacobian(self, rho: np.ndarray) -> sp.csr_matrix:
         """(3 n_cv, n_var) exact sparse Jacobian ``dr/drho``."""

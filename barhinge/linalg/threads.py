@@ -2,13 +2,14 @@
 
 Two kinds of work need different threading:
 
-* **small dense calls** (rigid kinematics and the DOF analysis: thousands of SVDs and
-  products of a few hundred entries each): a multithreaded BLAS spends more time waking
-  its threads than computing, and on a busy machine it competes with other processes for
-  the same cores. :func:`dense_calls` runs them with one BLAS thread.
-* **large sparse factorisations** (the bar-and-hinge tangent through MKL PARDISO): threads
-  pay off, but only as many as there are free cores. :func:`sparse_solves` limits MKL to the
-  cores the load average leaves free (at least one).
+* **small dense calls** (the DOF analysis: thousands of SVDs and products of a few hundred
+  entries each): a multithreaded BLAS spends more time waking its threads than computing,
+  and on a busy machine it competes with other processes for the same cores.
+  :func:`dense_calls` runs them with one BLAS thread.
+* **large sparse factorisations** (the bar-and-hinge tangent and the rigid corrector's
+  normal matrix through MKL PARDISO): threads pay off, but only as many as there are free
+  cores. :func:`sparse_solves` limits MKL to the cores the load average leaves free (at
+  least one) and other BLAS libraries to one thread.
 
 The policy is set by the environment variable ``BARHINGE_THREADS``:
 

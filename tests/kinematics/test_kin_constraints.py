@@ -134,3 +134,37 @@ def test_translation_part_is_automatic_at_a_vertex(vertex_pattern):
     L0 = np.linalg.norm(cp.vertices3d[cp.edges[:, 1]] - cp.vertices3d[cp.edges[:, 0]], axis=1)
     L = np.linalg.norm(X[cp.edges[:, 1]] - X[cp.edges[:, 0]], axis=1)
     np.testing.assert_allclose(L, L0, rtol=0, atol=1e-13)
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: RigidConstraints.from_pattern(bh.families.miura(3, 4, fold=30.0)),
+        lambda: RigidConstraints.from_pattern(
+            bh.families.miura(2, 2, fold=30.0), triangulated=True
+        ),
+        lambda: RigidConstraints.from_pattern(bh.families.waterbomb(2, 2)),
+    ],
+    ids=["miura", "miura-triangulated", "waterbomb"],
+)
+def test_normal_matrix_equals_the_jacobian_product(make):
+    """The normal matrix summed vertex by vertex on its fixed pattern equals J^T J (scipy's
+    sparse product) at a state off the manifold, stores every diagonal entry where it says,
+    and any other matrix falls back to the sparse product."""
+    import scipy.sparse as sp
+
+    rc = make()
+    x = rc.rho0 + 0.3 * np.random.default_rng(2).standard_normal(rc.n_var)
+    _, J = rc.evaluate(x)
+    ref = (J.T @ J).toarray()
+    K, diag = rc.normal_matrix(J)
+    np.testing.assert_allclose(K.toarray(), ref, rtol=0, atol=1e-13 * np.abs(ref).max())
+    rows = np.repeat(np.arange(rc.n_var), np.diff(K.indptr))
+    np.testing.assert_array_equal(K.indices[diag], np.arange(rc.n_var))
+    np.testing.assert_array_equal(rows[diag], np.arange(rc.n_var))
+    K2, _ = rc.normal_matrix(J)
+    assert K2.indptr is K.indptr  # the pattern is built once
+    other = sp.csr_matrix(J.toarray() * (np.abs(J.toarray()) > 0.3))
+    Ko, diag_o = rc.normal_matrix(other)
+    np.testing.assert_allclose(Ko.toarray(), (other.T @ other).toarray(), rtol=0, atol=1e-13)
+    np.testing.assert_allclose(Ko.data[diag_o], (other.T @ other).diagonal(), rtol=0, atol=1e-13)
