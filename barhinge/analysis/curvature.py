@@ -239,12 +239,15 @@ def mixed_voronoi_area(X: np.ndarray, triangles: np.ndarray) -> np.ndarray:
 
 def _boundary_nodes(triangles: np.ndarray, n_nodes: int) -> np.ndarray:
     """(n_nodes,) bool: nodes on an edge used by exactly one triangle."""
-    E = np.sort(
-        np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]]), axis=1
-    )
-    uniq, count = np.unique(E, axis=0, return_counts=True)
+    T = np.asarray(triangles, np.int64)
+    a = T.ravel()
+    b = np.roll(T, -1, axis=1).ravel()
+    key = np.minimum(a, b) * max(n_nodes, 1) + np.maximum(a, b)
+    uniq, count = np.unique(key, return_counts=True)
+    once = uniq[count == 1]
     flag = np.zeros(n_nodes, bool)
-    flag[uniq[count == 1].ravel()] = True
+    flag[once // max(n_nodes, 1)] = True
+    flag[once % max(n_nodes, 1)] = True
     return flag
 
 
@@ -276,8 +279,12 @@ def triangles_of_hinges(hinges: np.ndarray) -> np.ndarray:
 
 def pattern_triangles(cp: Any) -> np.ndarray:
     """(n_tri, 3) int: fan triangulation ``(f0, fi, fi+1)`` of a crease pattern's faces."""
-    tris = [(f[0], f[i], f[i + 1]) for f in cp.faces for i in range(1, len(f) - 1)]
-    return np.asarray(tris, dtype=np.int64).reshape(-1, 3)
+    ids, off = cp.face_loops
+    ntri = np.diff(off) - 2  # a face of k vertices gives k - 2 triangles
+    face = np.repeat(np.arange(len(ntri)), ntri)
+    i = np.arange(int(ntri.sum())) - np.repeat(np.cumsum(ntri) - ntri, ntri) + 1
+    first = off[:-1][face]
+    return np.column_stack([ids[first], ids[first + i], ids[first + i + 1]]).astype(np.int64)
 
 
 # ------------------------------------------------------------------------- entry point
@@ -348,7 +355,10 @@ def reference_points(X: np.ndarray, cp: Any | None) -> np.ndarray:
     if cp is None:
         return np.asarray(X, float)
     V = np.asarray(X, float)[: cp.n_vertices]
-    return np.array([V[list(f)].mean(0) for f in cp.faces])
+    ids, off = cp.face_loops
+    if not len(ids):
+        return np.zeros((0, 3))
+    return np.add.reduceat(V[ids], off[:-1], axis=0) / np.diff(off)[:, None]
 
 
 def gaussian_curvature(

@@ -312,7 +312,7 @@ def write_run(
                                   fixed=getattr(scene, "fixed", None),
                                   loads=getattr(scene, "loads", None), results=None)  # fmt: skip
         if viewer:
-            _write_viewer(run.path)
+            _write_viewer(run.path, model.pattern)
         run.manifest.update(
             scene=summary["scene"],
             kind=fold_path.kind,
@@ -328,13 +328,14 @@ def write_run(
     return RunOutput(out, files, summary, summary_rows(summary, fold_path))
 
 
-def _write_viewer(folder: Path) -> Path | None:
-    """``viewer.html`` of the result folder being written; a warning (not a failure) if it
-    cannot be made: the solved path is never lost for a picture."""
+def _write_viewer(folder: Path, pattern: Any) -> Path | None:
+    """``viewer.html`` of the result folder being written (``pattern``: the crease pattern
+    of its ``fold_path.fold``); a warning (not a failure) if it cannot be made: the solved
+    path is never lost for a picture."""
     from barhinge.view import write_viewer
 
     try:
-        return write_viewer(folder, folder / VIEWER)
+        return write_viewer(folder, folder / VIEWER, pattern=pattern)
     except Exception as exc:  # noqa: BLE001 - the viewer is an extra; keep the run
         log.warning("viewer not written: %s", exc)
         return None

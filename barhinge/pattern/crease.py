@@ -157,6 +157,23 @@ class CreasePattern:
             raise PatternError(f"no edge joins vertices {a} and {b}") from None
 
     @cached_property
+    def face_loops(self) -> tuple[np.ndarray, np.ndarray]:
+        """The face loops as flat arrays: (vertex ids of every face, concatenated; offsets
+        ``(n_faces + 1,)``: face ``f`` is ``ids[offsets[f]:offsets[f + 1]]``)."""
+        lens = np.fromiter((len(f) for f in self.faces), dtype=np.int64, count=self.n_faces)
+        ids = np.fromiter((v for f in self.faces for v in f), dtype=np.int64, count=int(lens.sum()))
+        return _readonly(ids), _readonly(np.concatenate([[0], np.cumsum(lens)]))
+
+    def _loop_neighbours(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(face of every loop position, index of the next position in its loop, index of
+        the previous one), over the flat arrays of :attr:`face_loops`."""
+        ids, off = self.face_loops
+        lens = np.diff(off)
+        fid = np.repeat(np.arange(self.n_faces), lens)
+        pos = np.arange(len(ids)) - off[fid]
+        return fid, off[fid] + (pos + 1) % lens[fid], off[fid] + (pos - 1) % lens[fid]
+
+    @cached_property
     def edge_faces(self) -> np.ndarray:
         """(m, 2) int: face on the left of the directed edge ``edges[e,0] -> edges[e,1]``
         (column 0) and on the right (column 1); -1 where there is none."""
@@ -166,12 +183,9 @@ class CreasePattern:
         faces = self.faces
         if not faces:
             return _readonly(EF)
-        lens = np.fromiter((len(f) for f in faces), dtype=np.int64, count=len(faces))
-        a = np.fromiter((v for f in faces for v in f), dtype=np.int64, count=int(lens.sum()))
-        start = np.repeat(np.cumsum(lens) - lens, lens)
-        pos = np.arange(len(a)) - start
-        b = a[start + (pos + 1) % np.repeat(lens, lens)]
-        fid = np.repeat(np.arange(len(faces)), lens)
+        a = self.face_loops[0]
+        fid, nxt, _ = self._loop_neighbours()
+        b = a[nxt]
         n = max(self.n_vertices, 1)
         E = self.edges
         key_e = np.minimum(E[:, 0], E[:, 1]) * n + np.maximum(E[:, 0], E[:, 1])
@@ -295,17 +309,17 @@ class CreasePattern:
         """Per face, the interior angle (radians) at each corner of its loop, in the current
         geometry: measured counter-clockwise about the face normal, so a reflex corner of a
         non-convex face is more than pi."""
+        if not self.n_faces:
+            return ()
         X = self.vertices3d
-        N = self.face_normals
-        out = []
-        for fi, f in enumerate(self.faces):
-            P = X[list(f)]
-            u = np.roll(P, -1, axis=0) - P
-            w = np.roll(P, 1, axis=0) - P
-            c = np.einsum("ij,ij->i", u, w)
-            s = np.cross(u, w) @ N[fi]
-            out.append(_readonly(np.mod(np.arctan2(s, c), 2 * np.pi)))
-        return tuple(out)
+        ids, off = self.face_loops
+        fid, nxt, prv = self._loop_neighbours()
+        P = X[ids]
+        u, w = X[ids[nxt]] - P, X[ids[prv]] - P
+        c = np.einsum("ij,ij->i", u, w)
+        s = np.einsum("ij,ij->i", np.cross(u, w), self.face_normals[fid])
+        angles = np.mod(np.arctan2(s, c), 2 * np.pi)
+        return tuple(_readonly(a) for a in np.split(angles, off[1:-1]))
 
     @cached_property
     def sector_angles(self) -> tuple[np.ndarray, ...]:
@@ -328,12 +342,12 @@ class CreasePattern:
     @cached_property
     def face_normals(self) -> np.ndarray:
         """(n_faces, 3) unit normals (Newell's method), +z for a counter-clockwise flat face."""
+        if not self.n_faces:
+            return _readonly(np.zeros((0, 3)))
         X = self.vertices3d
-        N = np.zeros((self.n_faces, 3))
-        for fi, f in enumerate(self.faces):
-            P = X[list(f)]
-            Q = np.roll(P, -1, axis=0)
-            N[fi] = np.cross(P, Q).sum(0)
+        ids, off = self.face_loops
+        _, nxt, _ = self._loop_neighbours()
+        N = np.add.reduceat(np.cross(X[ids], X[ids[nxt]]), off[:-1], axis=0)
         norm = np.linalg.norm(N, axis=1, keepdims=True)
         return _readonly(N / np.where(norm > 0, norm, 1.0))
 

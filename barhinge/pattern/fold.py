@@ -300,7 +300,7 @@ def read_fold(
 
 
 def _coords(V: np.ndarray) -> list[list[float]]:
-    return [[float(x) for x in row] for row in V]
+    return np.asarray(V, dtype=float).tolist()
 
 
 def fold_dict(cp: CreasePattern) -> dict[str, Any]:
@@ -424,7 +424,7 @@ def write_fold_path(cp: CreasePattern, fold_path: FoldPath, path: str | Path) ->
             "frame_inherit": True,
             "vertices_coords": _coords(X[s, :n]),
             # an angle that was not measured (NaN) is written as null
-            "edges_foldAngle": [float(a) if np.isfinite(a) else None for a in A[s]],
+            "edges_foldAngle": [a if math.isfinite(a) else None for a in A[s].tolist()],
         }
         lf = fold_path.load_factor
         if lf is not None and np.isfinite(lf[s]):

@@ -43,7 +43,9 @@ def write_viewer(
         half the size). ``"auto"``: 16-bit above
         :data:`~barhinge.view.html.QUANTISE_ABOVE` node-states.
     **kwargs
-        ``model``, ``scene``, ``pattern``, ``fixed``, ``loads``, ``title`` for a FoldPath.
+        ``model``, ``scene``, ``pattern``, ``fixed``, ``loads``, ``title`` for a FoldPath;
+        ``pattern`` for a result folder (the crease pattern of its ``fold_path.fold``, which
+        is then not read back).
 
     Returns
     -------

@@ -332,7 +332,9 @@ def _without_pattern(path: FoldPath, title: str | None) -> ViewData:
     )
 
 
-def _from_folder(folder: Path) -> ViewData:
+def _from_folder(folder: Path, pattern: Any | None = None) -> ViewData:
+    """The view of a result folder; ``pattern``: the crease pattern its ``fold_path.fold``
+    holds, when the caller has it (the run writer: reading the frames back is skipped)."""
     npz = folder / "fold_path.npz"
     if not npz.is_file():
         raise ConfigError(f"{folder} has no fold_path.npz: not a result folder of barhinge fold")
@@ -340,7 +342,7 @@ def _from_folder(folder: Path) -> ViewData:
     fold = folder / "fold_path.fold"
     if not fold.is_file():
         raise ConfigError(f"{folder} has no fold_path.fold (the crease pattern of the path)")
-    cp = read_fold(fold, validate=False)
+    cp = pattern if pattern is not None else read_fold(fold, validate=False)
     vtus = [folder / f"fold_path_{s:04d}.vtu" for s in range(path.n_states)]
     states = [read_state_vtu(f) for f in vtus] if all(f.is_file() for f in vtus) else None
     summary: dict[str, Any] = {}
@@ -389,7 +391,7 @@ def load_view_data(source: Any, **kwargs: Any) -> ViewData:
         return view_data(source, **kwargs)
     p = Path(source)
     if p.is_dir():
-        return _from_folder(p)
+        return _from_folder(p, kwargs.get("pattern"))
     if not p.exists():
         raise ConfigError(f"{p} does not exist")
     if p.suffix == ".npz":
