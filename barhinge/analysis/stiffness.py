@@ -25,6 +25,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from barhinge.errors import ConfigError
+from barhinge.linalg.backends import SingularMatrixError, get_backend
+from barhinge.linalg.threads import sparse_solves
 
 __all__ = [
     "EffectiveStiffness",
@@ -115,11 +117,13 @@ def linear_response(
         raise ConfigError(f"loads must have shape ({n}, 3), got {f.shape}")
     free = free_dofs(fixed, n)
     K = tangent_stiffness(model, X) if K is None else sp.csr_matrix(K)
-    Kff = K[free][:, free].tocsc()
+    Kff = K[free][:, free].tocsr()
     try:
-        lu = spla.splu(Kff)
-        uf = lu.solve(f.ravel()[free])
-    except RuntimeError as exc:  # exactly singular
+        # the solver's symmetric factorisation (PARDISO where installed, else SuperLU in
+        # symmetric mode): a general LU of this symmetric matrix fills in several times more
+        with sparse_solves():
+            uf = get_backend("auto").factorize(Kff).solve(f.ravel()[free])
+    except SingularMatrixError as exc:  # exactly singular
         raise ConfigError(
             "the supports leave a mechanism: the constrained tangent is singular "
             f"({len(free)} free DOFs)"
