@@ -121,14 +121,17 @@ def linear_response(
     try:
         # the solver's symmetric factorisation (PARDISO where installed, else SuperLU in
         # symmetric mode): a general LU of this symmetric matrix fills in several times more
+        ff = f.ravel()[free]
         with sparse_solves():
-            uf = get_backend("auto").factorize(Kff).solve(f.ravel()[free])
+            lu = get_backend("auto").factorize(Kff)
+            uf = lu.solve(ff)
+            uf += lu.solve(ff - Kff @ uf)  # one step of iterative refinement
     except SingularMatrixError as exc:  # exactly singular
         raise ConfigError(
             "the supports leave a mechanism: the constrained tangent is singular "
             f"({len(free)} free DOFs)"
         ) from exc
-    res = Kff @ uf - f.ravel()[free]
+    res = Kff @ uf - ff
     fn = max(float(np.linalg.norm(f)), 1e-300)
     if not np.all(np.isfinite(uf)) or np.linalg.norm(res) > 1e-4 * fn:
         raise ConfigError(
