@@ -17,6 +17,9 @@ the vectorised kernels produce).
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Sequence
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -30,6 +33,14 @@ def element_dofs(conn: np.ndarray) -> np.ndarray:
     )
 
 
+def _node_pair_keys(conn: np.ndarray, n_nodes: int) -> np.ndarray:
+    """``min * n_nodes + max`` of every node pair ``(a, b)``, ``a <= b`` locally, of every
+    element (entry-major: pair by pair, the elements within)."""
+    la, lb = np.triu_indices(conn.shape[1])
+    A, B = conn[:, la], conn[:, lb]
+    return (np.minimum(A, B) * n_nodes + np.maximum(A, B)).T.ravel()
+
+
 class Assembler:
     """Scatter maps for groups of elements sharing one global vector and matrix.
 
@@ -37,9 +48,14 @@ class Assembler:
     ----------
     n_nodes : int
     groups : list of (n_el, nodes_per_element) int arrays (e.g. bars, hinges)
+    pattern_groups : list of (n_el, nodes_per_element) int arrays, optional
+        Elements whose node pairs are in the pattern but whose values are added by the
+        caller (:meth:`add_entries`): no scatter map is kept for them.
     """
 
-    def __init__(self, n_nodes: int, groups: list[np.ndarray]) -> None:
+    def __init__(
+        self, n_nodes: int, groups: list[np.ndarray], pattern_groups: Sequence[np.ndarray] = ()
+    ) -> None:
         self.n_nodes = N = int(n_nodes)
         self.n_dof = n = 3 * N
         conns = [np.asarray(g, dtype=np.int64) for g in groups]
@@ -51,12 +67,10 @@ class Assembler:
         n_packed = sum(len(iu) * len(c) for c, (iu, _) in zip(conns, self.triu, strict=True))
 
         # 1. node-pair blocks: every element couples its node pairs (a <= b locally)
-        pair_keys, pair_of = [], []
-        for c in conns:
-            la, lb = np.triu_indices(c.shape[1])
-            A, B = c[:, la], c[:, lb]
-            pair_keys.append((np.minimum(A, B) * N + np.maximum(A, B)).T.ravel())
-            pair_of.append((la, lb))
+        pair_keys = [_node_pair_keys(c, N) for c in conns]
+        pair_of = [np.triu_indices(c.shape[1]) for c in conns]
+        n_valued = sum(len(k) for k in pair_keys)  # the pattern groups' keys come after
+        pair_keys += [_node_pair_keys(np.asarray(g, dtype=np.int64), N) for g in pattern_groups]
         allp = np.concatenate(pair_keys) if pair_keys else np.zeros(0, np.int64)
         del pair_keys
         ublk, inv = np.unique(allp, return_inverse=True)
@@ -65,7 +79,7 @@ class Assembler:
         self.n_upper = 9 * nblk  # a 3x3 slot per node-pair block (upper part on diagonals)
         # index dtype of every map below: int32 wherever the counts allow (halves the maps)
         itype = np.int32 if max(n_packed, 2 * self.n_upper, n) < 2**31 - 1 else np.int64
-        inv = inv.ravel().astype(itype)
+        inv = inv.ravel()[:n_valued].astype(itype)
         self._fdofs = self._fdofs.astype(itype)
 
         # 2. slot of every packed element entry (entry-major), one entry row at a time so
@@ -192,6 +206,32 @@ class Assembler:
         )
         K.has_sorted_indices = True
         return K
+
+    def add_entries(self, K: sp.csr_matrix, M: sp.spmatrix) -> None:
+        """Add the symmetric sparse matrix ``M``, whose entries lie in the pattern (e.g. the
+        ``pattern_groups``), into ``K`` (a matrix of this pattern) in place. Only the upper
+        triangle of ``M`` is read and mirrored, so ``K`` stays exactly symmetric."""
+        C = sp.triu(M, format="coo")
+        C.sum_duplicates()  # one entry per position: the fancy-index adds below are exact
+        r, c = C.row.astype(np.int64), C.col.astype(np.int64)
+        K.data[self._positions(r, c)] += C.data
+        off = r != c
+        K.data[self._positions(c[off], r[off])] += C.data[off]
+
+    def _positions(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """Positions in ``data`` of the entries ``(rows, cols)`` of the pattern."""
+        keys = self._pattern_keys
+        want = rows * self.n_dof + cols
+        pos = np.minimum(np.searchsorted(keys, want), max(len(keys) - 1, 0))
+        if len(want) and not np.array_equal(keys[pos], want):
+            raise ValueError("entries outside the assembler's sparsity pattern")
+        return pos
+
+    @functools.cached_property
+    def _pattern_keys(self) -> np.ndarray:
+        """Sorted ``row * n_dof + column`` of every entry of the pattern."""
+        rows = np.repeat(np.arange(self.n_dof, dtype=np.int64), np.diff(self.indptr))
+        return rows * self.n_dof + self.indices
 
     def matrix(self, element_matrices: list[np.ndarray]) -> sp.csr_matrix:
         """(n_dof, n_dof) CSR sum of symmetric element matrices ``(n_el, m, m)`` (element-major

@@ -34,6 +34,7 @@ from barhinge.kernels.geometry import (
     hinge_energy_hessian_packed,
 )
 from barhinge.kernels.laws import bar_linear
+from barhinge.linalg.backends import SingularMatrixError, get_backend
 
 __all__ = ["Buckling", "linear_buckling", "stiffness_parts", "geometric_stiffness"]
 
@@ -151,17 +152,23 @@ def linear_buckling(
     if len(free) < 2:
         raise ConfigError("linear buckling needs at least two free DOFs")
     K = model.tangent(X)
-    Kff = sp.csc_matrix(K[free][:, free])
+    Kff = sp.csr_matrix(K[free][:, free])
     try:
-        lu = spla.splu(Kff)
-    except RuntimeError as exc:
+        lu = get_backend("auto").factorize(Kff)  # symmetric: PARDISO, else SuperLU
+    except SingularMatrixError as exc:
         raise BucklingError(
             "linear buckling: the supported stiffness is singular (a mechanism); add supports"
         ) from exc
     du = np.zeros(3 * n)
-    du[free] = lu.solve(P.ravel()[free])
+    pf = P.ravel()[free]
+    du[free] = lu.solve(pf)
     if not np.all(np.isfinite(du)):
         raise BucklingError("linear buckling: the pre-buckling solve is not finite (mechanism)")
+    if np.linalg.norm(Kff @ du[free] - pf) > 1e-4 * max(float(np.linalg.norm(pf)), 1e-300):
+        # a (nearly) singular stiffness solved only approximately: the load moves a mechanism
+        raise BucklingError(
+            "linear buckling: the supported stiffness is singular (a mechanism); add supports"
+        )
     U = du.reshape(n, 3)
     eps, d, _ = bar_strain_derivatives(X, model.bars, model.bar_L0, model.strain)
     _, dSde, _ = bar_linear(eps, model.bar_EA, model.bar_L0)

@@ -25,6 +25,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from barhinge.errors import ConfigError
+from barhinge.linalg.backends import SingularMatrixError, get_backend
+from barhinge.linalg.threads import sparse_solves
 
 __all__ = [
     "EffectiveStiffness",
@@ -115,16 +117,21 @@ def linear_response(
         raise ConfigError(f"loads must have shape ({n}, 3), got {f.shape}")
     free = free_dofs(fixed, n)
     K = tangent_stiffness(model, X) if K is None else sp.csr_matrix(K)
-    Kff = K[free][:, free].tocsc()
+    Kff = K[free][:, free].tocsr()
     try:
-        lu = spla.splu(Kff)
-        uf = lu.solve(f.ravel()[free])
-    except RuntimeError as exc:  # exactly singular
+        # the solver's symmetric factorisation (PARDISO where installed, else SuperLU in
+        # symmetric mode): a general LU of this symmetric matrix fills in several times more
+        ff = f.ravel()[free]
+        with sparse_solves():
+            lu = get_backend("auto").factorize(Kff)
+            uf = lu.solve(ff)
+            uf += lu.solve(ff - Kff @ uf)  # one step of iterative refinement
+    except SingularMatrixError as exc:  # exactly singular
         raise ConfigError(
             "the supports leave a mechanism: the constrained tangent is singular "
             f"({len(free)} free DOFs)"
         ) from exc
-    res = Kff @ uf - f.ravel()[free]
+    res = Kff @ uf - ff
     fn = max(float(np.linalg.norm(f)), 1e-300)
     if not np.all(np.isfinite(uf)) or np.linalg.norm(res) > 1e-4 * fn:
         raise ConfigError(

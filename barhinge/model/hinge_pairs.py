@@ -11,67 +11,33 @@ entries ``(i, j)`` and ``(j, i)`` of every pair) the energy is ``d^T C d / 2``. 
 hinge ``i`` is ``(C d)_i``: it adds to the hinge's own moment, so the force and the
 ``moment x Hessian of the angle`` part of the tangent go through the hinge kernel unchanged.
 What is left is the cross term ``c (g_i g_j^T + g_j g_i^T)`` of every pair (``g`` the angle
-gradients), assembled here as an element over the union of the two hinges' nodes (5 to 8
-nodes; pairs are grouped by that count, so every group has a fixed element size).
+gradients): all of them together are ``G^T C G`` with ``G`` the (n_hinges, n_dof) matrix of
+the angle gradients, one sparse product per evaluation into entries the model's pattern
+holds (:func:`pair_nodes`). Per-pair element matrices (up to 231 values per pair on the
+union of the two hinges' nodes) took most of a refined panel's memory.
 """
 
 from __future__ import annotations
-
-import dataclasses
 
 import numpy as np
 import scipy.sparse as sp
 
 from barhinge.errors import ConfigError
 
-__all__ = ["PairLayout", "pair_layout", "pair_matrix", "pair_upper_values"]
+__all__ = ["pair_matrix", "pair_nodes"]
 
 
-@dataclasses.dataclass(frozen=True)
-class PairLayout:
-    """Element layout of the pairs of one size group.
-
-    Attributes
-    ----------
-    pairs : (n,) int, indices into the model's pair list
-    nodes : (n, u) int, the union of the two hinges' nodes (each node once)
-    rows_i, rows_j : (12, n) int, row of each gradient entry of hinge i / j (node-major,
-        xyz) in the element's ``3 u`` vector
-    """
-
-    pairs: np.ndarray
-    nodes: np.ndarray
-    rows_i: np.ndarray
-    rows_j: np.ndarray
-
-
-def pair_layout(hinges: np.ndarray, pairs: np.ndarray) -> list[PairLayout]:
-    """Group the pairs by the number of distinct nodes of their two hinges (built once).
+def pair_nodes(hinges: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """(n_pairs, 8) int: the nodes of both hinges of every pair (a node shared by the two
+    appears twice): every node pair of a row is an entry of the couplings' tangent.
 
     Parameters
     ----------
     hinges : (n_hinges, 4) int
     pairs : (n_pairs, 2) int hinge indices
     """
-    if len(pairs) == 0:
-        return []
-    both = np.concatenate([hinges[pairs[:, 0]], hinges[pairs[:, 1]]], axis=1)  # (n, 8)
-    srt = np.sort(both, axis=1)
-    first = np.ones_like(srt, dtype=bool)
-    first[:, 1:] = srt[:, 1:] != srt[:, :-1]
-    count = first.sum(axis=1)
-    out = []
-    for u in np.unique(count):
-        sel = np.flatnonzero(count == u)
-        nodes = srt[sel][first[sel]].reshape(len(sel), int(u))
-        # position of each of the 8 hinge nodes in the sorted unique list
-        big = int(hinges.max()) + 1
-        off = (np.arange(len(sel)) * big)[:, None]
-        pos = np.searchsorted((nodes + off).ravel(), (both[sel] + off).ravel()).reshape(-1, 8)
-        pos -= (np.arange(len(sel)) * int(u))[:, None]
-        rows = (3 * pos[:, :, None] + np.arange(3)).reshape(len(sel), 24).T  # (24, n)
-        out.append(PairLayout(sel, nodes, rows[:12].copy(), rows[12:].copy()))
-    return out
+    H, P = np.asarray(hinges, np.int64), np.asarray(pairs, np.int64).reshape(-1, 2)
+    return np.concatenate([H[P[:, 0]], H[P[:, 1]]], axis=1)
 
 
 def pair_matrix(n_hinges: int, pairs: np.ndarray, pair_k: np.ndarray) -> sp.csr_matrix:
@@ -84,29 +50,3 @@ def pair_matrix(n_hinges: int, pairs: np.ndarray, pair_k: np.ndarray) -> sp.csr_
         shape=(n_hinges, n_hinges),
     )
     return C.tocsr()
-
-
-def pair_upper_values(
-    layout: PairLayout, grad: np.ndarray, pairs: np.ndarray, pair_k: np.ndarray, out: np.ndarray
-) -> None:
-    """Packed upper triangle (entry-major) of ``c (G_i G_j^T + G_j G_i^T)`` of one group.
-
-    Parameters
-    ----------
-    layout : the group
-    grad : (12, n_hinges) component-major angle gradients of all hinges
-    pairs, pair_k : the model's pairs and couplings
-    out : (m (m + 1) / 2, n) with ``m = 3 u``, written in place
-    """
-    n = len(layout.pairs)
-    m = 3 * layout.nodes.shape[1]
-    p = pairs[layout.pairs]
-    cols = np.arange(n)
-    Gi = np.zeros((m, n))
-    Gj = np.zeros((m, n))
-    Gi[layout.rows_i, cols] = grad[:, p[:, 0]]
-    Gj[layout.rows_j, cols] = grad[:, p[:, 1]]
-    Gi *= pair_k[layout.pairs]
-    iu, ju = np.triu_indices(m)
-    np.multiply(Gi[iu], Gj[ju], out=out)
-    out += Gj[iu] * Gi[ju]

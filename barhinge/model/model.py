@@ -20,7 +20,7 @@ import scipy.sparse as sp
 
 from barhinge import _check
 from barhinge._typing import SCHEMES, Scheme, StrainMeasure
-from barhinge.assembly import Assembler
+from barhinge.assembly import Assembler, element_dofs
 from barhinge.errors import ConfigError
 from barhinge.kernels.geometry import (
     bar_strain,
@@ -43,7 +43,7 @@ from barhinge.model.calibrate import (
     fold_stiffness as _fold_stiffness,
 )
 from barhinge.model.continuum import panel_corner_stiffness, plate_corner_stiffness
-from barhinge.model.hinge_pairs import PairLayout, pair_layout, pair_matrix, pair_upper_values
+from barhinge.model.hinge_pairs import pair_matrix, pair_nodes
 from barhinge.model.material import Material
 from barhinge.model.topology import build_topology
 from barhinge.model.triangulate import triangulate
@@ -401,16 +401,28 @@ class BarHingeModel:
     @cached_property
     def assembler(self) -> Assembler:
         """Sparsity pattern and scatter maps (built once)."""
-        groups = [self.bars, self.hinges] + [g.nodes for g in self._pair_groups]
-        return Assembler(self.n_nodes, groups)
-
-    @cached_property
-    def _pair_groups(self) -> list[PairLayout]:
-        return pair_layout(np.asarray(self.hinges), np.asarray(self.hinge_pairs))
+        # the hinge couplings' entries are in the pattern; their values come from one sparse
+        # product per evaluation (:meth:`_add_pair_tangent`), not from per-pair element
+        # matrices (up to 231 values per pair, most of a refined panel's memory)
+        pairs = [pair_nodes(self.hinges, self.hinge_pairs)] if len(self.hinge_pairs) else []
+        return Assembler(self.n_nodes, [self.bars, self.hinges], pattern_groups=pairs)
 
     @cached_property
     def _pair_C(self) -> sp.csr_matrix:
         return pair_matrix(self.n_hinges, np.asarray(self.hinge_pairs), np.asarray(self.pair_k))
+
+    def _add_pair_tangent(self, K: sp.csr_matrix, grad: np.ndarray) -> None:
+        """Add the hinge couplings' tangent ``G^T C G`` into ``K`` (in place): ``G``
+        (n_hinges, n_dof) the hinge-angle gradients ``grad`` (12, n_hinges; node-major) and
+        ``C`` the coupling matrix. The pairs' second-order part (moment times the angle's
+        Hessian) is in each hinge's own element, whose moment includes ``C (rho - rho0)``."""
+        nh = self.n_hinges
+        dofs = element_dofs(np.asarray(self.hinges))
+        G = sp.csr_matrix(
+            (np.ascontiguousarray(grad.T).ravel(), dofs.ravel(), np.arange(0, 12 * nh + 1, 12)),
+            shape=(nh, self.n_dof),
+        )
+        self.assembler.add_entries(K, G.T @ (self._pair_C @ G))
 
     def _pair_moment(self, rho: np.ndarray) -> np.ndarray | None:
         """(n_hinges,) moments ``C (rho - rho0)`` of the hinge couplings (None without)."""
@@ -484,11 +496,9 @@ class BarHingeModel:
         if len(self.hinge_pairs):
             law = functools.partial(law, pair_moment=self._pair_moment(hinge_angle(X, hinges)))
         if tangent:
-            flat, (Kb, Hp, *Pp) = asm.value_buffers()
+            flat, (Kb, Hp) = asm.value_buffers()
             # g (12, nh), Hp (78, nh): packed upper triangle of the hinge energy Hessian
             rho, M, Kt, Wh, g, _ = hinge_energy_hessian_packed(X, hinges, law, Hp)
-            for group, out in zip(self._pair_groups, Pp, strict=True):
-                pair_upper_values(group, g, self.hinge_pairs, self.pair_k, out)
         else:
             rho, g = hinge_angle_gradient_t(X, hinges)
             M, Kt, Wh = self._hinge_law(rho)
@@ -506,6 +516,8 @@ class BarHingeModel:
                 if p_ != _BAR_FIRST[q]:
                     np.multiply(Kb[_BAR_FIRST[q]], sgn, out=Kb[p_])
             K = asm.matrix_packed(flat)
+            if len(self.hinge_pairs):
+                self._add_pair_tangent(K, g)
         f = self._is_fold
         return Evaluation(
             energy_bars=float(Wb.sum()),

@@ -197,3 +197,50 @@ def test_model_pickles_and_evaluates_the_same() -> None:
     m2 = pickle.loads(pickle.dumps(m))
     ev2 = m2.evaluate(X)
     assert ev2.energy == ev.energy and np.array_equal(ev2.K.toarray(), ev.K.toarray())
+
+
+def test_pattern_groups_hold_entries_that_add_entries_fills_symmetrically() -> None:
+    """Elements given as ``pattern_groups`` put their node-pair blocks in the pattern (zero
+    until filled); ``add_entries`` adds a symmetric matrix there exactly as a dense sum
+    would, keeps the result bitwise symmetric, and names entries outside the pattern."""
+    import scipy.sparse as sp
+
+    from barhinge.assembly import Assembler
+
+    bars = np.array([[0, 1], [1, 2], [2, 3]])
+    extra = np.array([[0, 3]])
+    asm = Assembler(4, [bars], pattern_groups=[extra])
+    rng = np.random.default_rng(0)
+    Kb = rng.normal(size=(3, 6, 6))
+    K = asm.matrix([Kb + Kb.transpose(0, 2, 1)])
+    dense = K.toarray()
+    assert asm.pattern().toarray()[0:3, 9:12].all()  # the extra block is in the pattern
+    assert not dense[0:3, 9:12].any()  # and holds zeros
+    M = np.zeros((12, 12))
+    B = rng.normal(size=(3, 3))
+    M[0:3, 9:12], M[9:12, 0:3] = B, B.T
+    M[4, 4] = 2.5
+    asm.add_entries(K, sp.csr_matrix(M))
+    np.testing.assert_allclose(K.toarray(), dense + M, rtol=0, atol=1e-15)
+    assert np.array_equal(K.toarray(), K.toarray().T)
+    outside = np.zeros((12, 12))
+    outside[0, 7] = outside[7, 0] = 1.0  # nodes 0 and 2 share no element
+    with pytest.raises(ValueError, match="outside"):
+        asm.add_entries(K, sp.csr_matrix(outside))
+
+
+def test_hinge_couplings_keep_the_scatter_maps_small() -> None:
+    """Couplings of a refined panel's hinges (the coupled plate rule: several per hinge) add
+    their entries to the pattern, not element matrices to the scatter maps: the maps hold no
+    more than with the hinges uncoupled plus the pattern's own growth (an index and a gather
+    entry per new entry, and the upper blocks' pointers: 10 bytes; a per-pair element over
+    the 5 to 8 nodes of two hinges would add 120 to 231 packed values, 12 bytes each)."""
+    from barhinge.model.plate_hinges import coupled_bending
+    from barhinge.pattern.subdivide import subdivided
+
+    cpm, _ = subdivided(bh.families.miura(1, 1, fold=30.0), 4)
+    plain = BarHingeModel.from_pattern(cpm, "N5B8", MAT)
+    coupled = coupled_bending(plain)
+    assert len(coupled.hinge_pairs) > 2 * coupled.n_hinges
+    a, b = plain.assembler, coupled.assembler
+    assert b.nbytes <= a.nbytes + 12 * (b.nnz - a.nnz)
