@@ -20,7 +20,7 @@ import scipy.sparse as sp
 
 from barhinge import _check
 from barhinge._typing import SCHEMES, Scheme, StrainMeasure
-from barhinge.assembly import Assembler, element_dofs
+from barhinge.assembly import Assembler
 from barhinge.errors import ConfigError
 from barhinge.kernels.geometry import (
     bar_strain,
@@ -417,12 +417,13 @@ class BarHingeModel:
         ``C`` the coupling matrix. The pairs' second-order part (moment times the angle's
         Hessian) is in each hinge's own element, whose moment includes ``C (rho - rho0)``."""
         nh = self.n_hinges
-        dofs = element_dofs(np.asarray(self.hinges))
+        asm = self.assembler
+        dofs = asm.dofs[1]  # the hinges' (n_hinges, 12) dofs, the assembler's second group
         G = sp.csr_matrix(
             (np.ascontiguousarray(grad.T).ravel(), dofs.ravel(), np.arange(0, 12 * nh + 1, 12)),
             shape=(nh, self.n_dof),
         )
-        self.assembler.add_entries(K, G.T @ (self._pair_C @ G))
+        asm.add_entries(K, G.T @ (self._pair_C @ G))
 
     def _pair_moment(self, rho: np.ndarray) -> np.ndarray | None:
         """(n_hinges,) moments ``C (rho - rho0)`` of the hinge couplings (None without)."""
