@@ -77,8 +77,8 @@ class SolverOptions:
         ``v + a / 2`` when ``2 |a| <= |v|``. Along a near-mechanism the plain step leaves
         the curved valley of the soft mode and stretches the bars (the next iterate's
         residual jumps); the corrected step follows the valley to second order. Off by
-        default; on the Miura benchmarks it saves a quarter or more of the Newton
-        factorisations (docs/solver-performance.md, the acceleration table). Not used
+        default; on the Miura benchmarks it saves Newton factorisations, the more the
+        softer the sheet (docs/solver-performance.md, the acceleration table). Not used
         under arc length.
     reuse_factorization : bool
         Reuse a factorisation over Newton iterations and increments as the preconditioner
