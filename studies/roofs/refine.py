@@ -255,8 +255,13 @@ def stable(r: dict, c: dict[str, str] | None) -> tuple[bool, str]:
     return not why, "; ".join(why)
 
 
+#: families that are baselines, not roofs: left out of the ranking
+BASELINES = ("flat",)
+
+
 def ranking(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
-    order = sorted(results, key=lambda r: -r["stiffness_per_width"])
+    roofs_only = [r for r in results if r["family"] not in BASELINES]
+    order = sorted(roofs_only, key=lambda r: -r["stiffness_per_width"])
     ok, bad = [], []
     for r in order:
         st, why = stable(r, coarse.get(_key(r["family"], r["state"])))
@@ -272,7 +277,7 @@ def ranking(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
         [
             "Stiffest refined roofs that carry the design load (refined linear buckling factor"
             " above 1, and no limit point or bifurcation below load factor 1 on the comparison"
-            " table's nonlinear path):",
+            " table's nonlinear path; the flat sheet, a baseline, is left out):",
             "",
             *(ok or ["(none)"]),
             "",
@@ -377,7 +382,7 @@ def chart(results: list[dict], path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fams = list(dict.fromkeys(r["family"] for r in results))
+    fams = [f for f in dict.fromkeys(r["family"] for r in results) if f not in BASELINES]
     fig, axes = plt.subplots(2, len(fams), figsize=(2.6 * len(fams), 5.4), squeeze=False)
     for j, fam in enumerate(fams):
         for r in (r for r in results if r["family"] == fam):

@@ -79,7 +79,7 @@ def test_interrupted_run_resumes_from_its_cache(study, tmp_path, monkeypatch) ->
 
 def test_ranking_states_every_roof_once(study) -> None:
     text = study.ranking(study.RESULTS, {})
-    for r in study.RESULTS:
+    for r in study.RESULTS:  # the quick roofs are no baselines
         label = f"{r['family']} {r['state']:g}:"
         assert text.count(label) == 1
         ok, why = study.stable(r, None)
