@@ -15,6 +15,10 @@ step, wall and CPU time (medians over ``--repeat``), and per size the ratio comp
 quasi-rigid of the Newton factorisations (all less the inertia ones, which both sets make
 once per state) and of the wall time (issue 19 asks for at most 2). The figures come
 from ``FoldPath.meta["newton"]`` and ``meta["timing"]``.
+
+A second table runs every size and set again with the other setting of the geodesic
+acceleration of the Newton corrections (option ``acceleration``) and gives the ratio of
+iterations, Newton factorisations and wall time, accelerated / plain.
 """
 
 from __future__ import annotations
@@ -65,6 +69,7 @@ def run(n: int, material: str, steps: int, options: dict) -> dict:
         "fact1": nw["factorizations"][0],
         "inertia": nw["total_inertia_factorizations"],
         "max_iter": max(nw["iterations"]),
+        "accelerated": path.meta["timing"]["n_accelerated"],
         "wall": wall,
         "cpu": cpu,
     }
@@ -92,8 +97,10 @@ def main() -> None:
     out("| " + " | ".join(COLS) + " |")
     out("|" + "---|" * len(COLS))
     ratios = []
+    all_rows = []
     for n in a.sizes:
         rows = {}
+        all_rows.append((n, rows))
         for material in ("quasi-rigid", "compliant"):
             runs = [run(n, material, a.steps, options) for _ in range(a.repeat)]
             r = dict(runs[-1])
@@ -126,6 +133,28 @@ def main() -> None:
     out("|---|---|---|")
     for n, rf, rw in ratios:
         out(f"| {n} | {rf:.2f} | {rw:.2f} |")
+    accelerated = bool(options.get("acceleration", False))
+    out()
+    out("### Geodesic acceleration (option `acceleration`): plain and accelerated Newton")
+    out(
+        "| n | material | iterations plain / accelerated | accelerated corrections | "
+        "Newton factorisations plain / accelerated | wall s plain / accelerated | "
+        "ratio of Newton factorisations | ratio of wall time |"
+    )
+    out("|---|---|---|---|---|---|---|---|")
+    for n, rows in all_rows:
+        for material, r in rows.items():
+            other = [run(n, material, a.steps, {**options, "acceleration": not accelerated})
+                     for _ in range(a.repeat)]  # fmt: skip
+            o = dict(other[-1])
+            o["wall"] = statistics.median(x["wall"] for x in other)
+            p, q = (o, r) if accelerated else (r, o)  # plain, accelerated
+            fp, fa = p["fact"] - p["inertia"], q["fact"] - q["inertia"]
+            out(
+                f"| {n} | {material} | {p['iterations']} / {q['iterations']} | "
+                f"{q['accelerated']} | {fp} / {fa} | {p['wall']:.2f} / {q['wall']:.2f} | "
+                f"{fa / fp:.2f} | {q['wall'] / p['wall']:.2f} |"
+            )
     if a.publish:
         publish(lines, a)
 

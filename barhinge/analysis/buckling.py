@@ -35,6 +35,7 @@ from barhinge.kernels.geometry import (
 )
 from barhinge.kernels.laws import bar_linear
 from barhinge.linalg.backends import SingularMatrixError, get_backend
+from barhinge.linalg.threads import threads_for_sparse
 
 __all__ = ["Buckling", "linear_buckling", "stiffness_parts", "geometric_stiffness"]
 
@@ -112,6 +113,7 @@ def stiffness_parts(model: Any, X: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_ma
     return Km, Kg
 
 
+@threads_for_sparse
 def linear_buckling(
     model: Any,
     loads: np.ndarray,

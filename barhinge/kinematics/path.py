@@ -190,11 +190,18 @@ class RigidSolver:
         self.last_guess: np.ndarray | None = None
 
     # ---------------------------------------------------------------- linear algebra
-    def _held_normal(self, J: sp.csr_matrix, shift: np.ndarray | float) -> sp.csr_matrix:
+    def _held_normal(
+        self, J: sp.csr_matrix, shift: np.ndarray | float = 0.0, *, regularise: bool = False
+    ) -> sp.csr_matrix:
         """``D (J^T J + diag(shift)) D + (I - D)`` with ``D`` the free creases (the held
         actuators' rows and columns replaced by the identity), on the constraints' fixed
-        pattern (a factorisation reuses its ordering)."""
+        pattern (a factorisation reuses its ordering). ``regularise`` adds a tiny
+        stiffness-weighted shift, ``1e-12`` of the largest diagonal entry of ``J^T J``."""
         K, diag = self.rc.normal_matrix(J)
+        if regularise:
+            w = self.weights
+            scale = float(K.data[diag].max(initial=1.0)) / float(w.max(initial=1.0))
+            shift = shift + 1e-12 * scale * w
         if self._mask_of[0] is not K.indptr or self._mask_of[1] is not self.free:
             rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
             self._keep = self.free[rows] & self.free[K.indices]
@@ -204,15 +211,10 @@ class RigidSolver:
         return K
 
     def _factor(self, J: sp.csr_matrix) -> None:
-        shift: np.ndarray | float = 0.0
-        if self.underactuated is not False:
-            # a tiny stiffness-weighted regularisation keeps the normal matrix regular where
-            # the actuators leave free motions (the right-hand side J^T r has no component
-            # along them, so the step stays the minimum-norm Gauss-Newton step)
-            w = self.weights
-            scale = float(_normal_diagonal(J).max(initial=1.0)) / float(w.max(initial=1.0))
-            shift = 1e-12 * scale * w
-        K = self._held_normal(J, shift)
+        # where the actuators leave free motions a tiny stiffness-weighted regularisation
+        # keeps the normal matrix regular (the right-hand side J^T r has no component along
+        # them, so the step stays the minimum-norm Gauss-Newton step)
+        K = self._held_normal(J, regularise=self.underactuated is not False)
         try:
             # symmetric positive (semi)definite; the solver's fastest backend (PARDISO where
             # installed, else SuperLU with symmetric settings), ordering reused across steps.

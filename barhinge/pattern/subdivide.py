@@ -16,7 +16,7 @@ import numpy as np
 from barhinge.errors import PatternError
 from barhinge.pattern.crease import CreasePattern
 
-__all__ = ["subdivided"]
+__all__ = ["subdivided", "subdivided_size"]
 
 
 def subdivided(cp: CreasePattern, m: int) -> tuple[CreasePattern, np.ndarray]:
@@ -138,8 +138,30 @@ def subdivided(cp: CreasePattern, m: int) -> tuple[CreasePattern, np.ndarray]:
         assignment=np.array(asg),
         fold_angles=np.array(fold),
         faces=faces,
+        developable=cp.developable,
     )
     return out, np.concatenate(pedge)
+
+
+def subdivided_size(cp: CreasePattern, m: int) -> tuple[int, int]:
+    """(vertices, quadrilateral faces) of ``subdivided(cp, m)``, counted without building it.
+
+    Each edge gains ``m - 1`` points, each quadrilateral ``(m - 1)^2`` inner points and
+    ``m^2`` faces, each triangle ``(m - 1)(m - 2) / 2`` inner points and ``m^2`` faces. An N5B8
+    model of the subdivided pattern has ``3 (vertices + quadrilaterals)`` DOFs (one centre
+    node per quadrilateral), which is how a refinement plans its next level against a
+    memory budget.
+    """
+    if not isinstance(m, (int, np.integer)) or m < 1:
+        raise PatternError(f"subdivision m = {m!r}; expected an integer >= 1")
+    sizes = np.array([len(f) for f in cp.faces])
+    n_quad, n_tri = int((sizes == 4).sum()), int((sizes == 3).sum())
+    if n_quad + n_tri != len(sizes) and m > 1:
+        raise PatternError("subdivision cuts triangles and quadrilaterals only")
+    m = int(m)
+    n_v = cp.n_vertices + cp.n_edges * (m - 1) + n_quad * (m - 1) ** 2
+    n_v += n_tri * (m - 1) * (m - 2) // 2
+    return n_v, n_quad * m * m
 
 
 def _on_side(a: tuple[int, int], b: tuple[int, int], m: int) -> bool:

@@ -59,6 +59,7 @@ class Timer:
     n_iterations: int = 0
     n_krylov: int = 0
     n_force_only: int = 0  # evaluations without the tangent (convergence expected)
+    n_accelerated: int = 0  # Newton corrections taken with their geodesic acceleration
 
     def as_dict(self) -> dict[str, float]:
         return dataclasses.asdict(self)

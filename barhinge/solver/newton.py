@@ -32,6 +32,14 @@ from barhinge.solver.state import Evaluation, IncrementFailed, State, StepRecord
 from barhinge.solver.work import WORK_TOLERANCE, WorkIntegrator
 from barhinge.solver_options import SolverOptions
 
+#: step of the central second difference of the geodesic acceleration, as a fraction of the
+#: Newton correction (odd orders cancel, so the residual's cubic terms along a
+#: near-mechanism, which make the chord correction blow up, do not enter)
+ACCELERATION_H = 0.5
+#: the acceleration is kept when |a| <= ACCELERATION_RATIO |v| (the step's second-order
+#: part small against its first-order part)
+ACCELERATION_RATIO = 0.5
+
 if TYPE_CHECKING:
     from barhinge.scene import Scene
 
@@ -129,10 +137,35 @@ class _Driver:
             # tangent too much for the previous factorisation to precondition it
             ctx.factorize_or_fail(e, new, res, reuse=n_iter > 0)
             n_iter += 1
-            dx, dmu = self.system.solve(-e.r[free], -e.c, rtol=self.conv.forcing(e, new, rf))
+            rtol = self.conv.forcing(e, new, rf)
+            dx, dmu = self.system.solve(-e.r[free], -e.c, rtol=rtol)
+            if o.acceleration:
+                dx, dmu = self._accelerated(new, e, dx, dmu, rtol)
             light = self._expects_convergence(res)
             new, e, alpha = self.conv.line_search(new, e, dx, dmu, light)
             dx_last = alpha * dx
+
+    def _accelerated(
+        self, st: State, e: Evaluation, dx: np.ndarray, dmu: np.ndarray, rtol: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The Newton correction ``(dx, dmu)`` at ``st`` with its geodesic acceleration
+        (option ``acceleration``): ``v + a / 2`` with ``K a = -r''[v, v]`` (central second
+        difference, step ``ACCELERATION_H``), kept when ``2 |a| <= |v|``."""
+        ctx, h = self.ctx, ACCELERATION_H
+        ev = []
+        for sign in (1.0, -1.0):
+            trial = State(st.x.copy(), st.mu + sign * h * dmu, st.lam, st.t)
+            trial.x[self.free] += sign * h * dx
+            ev.append(ctx.evaluate(trial, tangent=False))
+        r2 = (ev[0].r + ev[1].r - 2.0 * e.r) / (h * h)
+        c2 = (ev[0].c + ev[1].c - 2.0 * e.c) / (h * h)
+        if not (np.all(np.isfinite(r2)) and np.all(np.isfinite(c2))):
+            return dx, dmu
+        a, amu = self.system.solve(-r2[self.free], -c2, rtol=rtol)
+        if float(np.linalg.norm(a)) > ACCELERATION_RATIO * float(np.linalg.norm(dx)):
+            return dx, dmu  # the step is too long for the valley's curvature
+        self.ctx.timer.n_accelerated += 1
+        return dx + 0.5 * a, dmu + 0.5 * amu
 
     def _expects_convergence(self, res: list[float]) -> bool:
         return self.conv.expects_convergence(res)

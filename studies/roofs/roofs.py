@@ -368,6 +368,89 @@ def flat_line_stiffness(model, crease: np.ndarray) -> Any:
     return model.with_(hinge_k=k)
 
 
+#: bending rules of a roof whose panels are cut into sub-panels: name -> keywords of
+#: ``BarHingeModel.from_pattern``. ``plate`` and ``kirchhoff`` are per-panel calibrations
+#: (flat lines get ``D l / s``); ``consistent`` and ``coupled`` then set every hinge inside
+#: and between sub-panels by :mod:`barhinge.model.plate_hinges` (the plate patch test;
+#: ``coupled`` also keeps the sheet's Poisson ratio), and converge to the plate
+BENDING_RULES: dict[str, dict[str, Any]] = {
+    "plate": {},
+    "kirchhoff": {"bend_calibration": "kirchhoff"},
+    "consistent": {"bend_calibration": "kirchhoff"},
+    "coupled": {"bend_calibration": "kirchhoff"},
+}
+
+
+#: a roof is refined when its stiffness changes by less than this between two levels
+REFINE_TOL = 0.02
+#: no refinement level above this many DOFs (the largest takes a few minutes and ~8 GB)
+REFINE_DOF_BUDGET = 650_000
+
+
+def settled(k: list[float], tol: float = REFINE_TOL) -> bool:
+    """Whether a refinement sequence ``k`` (one value per level) has settled: its last change
+    is below ``tol`` (relative) *and* it is in its asymptotic range, the same sign as the
+    change before and smaller. A sequence that turns (its changes of opposite signs) can
+    pass through a small change by chance and needs another level."""
+    if len(k) < 3:
+        return False
+    d1, d2 = k[-2] / k[-3] - 1.0, k[-1] / k[-2] - 1.0
+    return abs(d2) < tol and d1 * d2 > 0 and abs(d2) < abs(d1)
+
+
+def refinement_dofs(cp, m: int) -> int:
+    """DOFs of the N5B8 model of ``cp`` with m x m sub-panels, counted without building it."""
+    from barhinge.pattern.subdivide import subdivided_size
+
+    return 3 * sum(subdivided_size(cp, m))
+
+
+def subdivided_roof(
+    cp, sv: np.ndarray, se: np.ndarray, m: int, rule: str = "coupled", scheme: str = "N5B8",
+    material: Any = None,
+) -> tuple[Any, np.ndarray, float]:  # fmt: skip
+    """A roof's bar-and-hinge model with every panel cut into ``m x m`` sub-panels.
+
+    Parameters
+    ----------
+    cp : the folded roof's crease pattern; sv, se : its supported vertices and edges
+        (:func:`support_lines`)
+    m : sub-panels per panel side (1: the panels as they are)
+    rule : a key of ``BENDING_RULES``
+    material : the sheet (default: the study's)
+
+    Returns
+    -------
+    model : BarHingeModel
+    fixed : (n_nodes, 3) bool, the supported vertices and every new vertex on a supported
+        edge, pinned
+    patch_residual : largest cell residual of the plate patch test over D (0 for the
+        per-panel rules)
+    """
+    import barhinge as bh
+    from barhinge.model.plate_hinges import consistent_hinge_stiffness, coupled_bending
+    from barhinge.pattern.subdivide import subdivided
+
+    if rule not in BENDING_RULES:
+        raise ValueError(f"bending rule {rule!r}; expected one of {sorted(BENDING_RULES)}")
+    cpm, parent = subdivided(cp, m)
+    mat = material if material is not None else globals()["material"]()
+    model = bh.BarHingeModel.from_pattern(cpm, scheme, mat, **BENDING_RULES[rule])
+    residual = 0.0
+    if rule == "coupled":
+        model = coupled_bending(model)
+        residual = float(model.meta["cell_residual"])
+    elif rule == "consistent":
+        ph = consistent_hinge_stiffness(model)
+        model = model.with_(hinge_k=ph.hinge_k)
+        residual = float(ph.residual.max(initial=0.0))
+    elif "F" in set(np.asarray(cpm.assignment)):
+        model = flat_line_stiffness(model, np.isin(np.asarray(cpm.assignment), ["M", "V"]))
+    S = np.zeros((model.n_nodes, 3), bool)
+    S[np.union1d(sv, np.flatnonzero(np.isin(parent, se)))] = True
+    return model, S, residual
+
+
 def analyse(family: str, state: float, scheme: str = "N5B8", **override) -> dict[str, Any]:
     """Linear response of one roof at its (stress-free) folded state.
 

@@ -163,7 +163,10 @@ def ranking(top: int = 6) -> str:
     stable."""
     ok = sorted((r for r in RESULTS if stable(r)), key=lambda r: -r["stiffness_per_width"])
     bad = sorted((r for r in RESULTS if not stable(r)), key=lambda r: -r["stiffness_per_width"])
-    lines = ["Stiffest roofs that carry the design load (no limit point or bifurcation below "
+    lines = ["One facet per panel, a screening model whose stiffnesses are high and whose "
+             "buckling factors move under refinement: the ranking to design with is the "
+             "refined one (*Refined: every roof until its stiffness settles*, below).", "",
+             "Stiffest roofs that carry the design load (no limit point or bifurcation below "
              "load factor 1, linear buckling factor above 1):", ""]  # fmt: skip
     for i, r in enumerate(ok[:top], 1):
         lines.append(

@@ -178,7 +178,7 @@ def run(quick: bool, out: Path, serial: bool, workers: int | None, retry_failed:
     from barhinge.sweep import Study, read_records, run_study
 
     study = Study(
-        function="transform:cell",
+        function="cells:cell",
         points=tuple(runs(quick)),
         fixed={"quick": quick, "steps": settings(quick)["steps"]},
         name="transformations-quick" if quick else "transformations",

@@ -300,17 +300,3 @@ def placement_point(
         "KL2": float(K) * L * L,
         "KL2_reference": float(K_ref) * L * L,
     }
-
-
-def cell(kind: str, pattern: str, quick: bool = True, steps: int = 6, **params) -> dict:
-    """One run of the study: ``kind`` is ``"form"`` (:func:`point`), ``"placement"``
-    (:func:`placement_point`) or ``"design"`` (``design.design``)."""
-    if kind == "form":
-        return point(pattern, quick=quick, steps=steps, **params)
-    if kind == "placement":
-        return placement_point(pattern, quick=quick, steps=steps, **params)
-    if kind == "design":
-        from design import design
-
-        return design(pattern, quick=quick, **params)
-    raise ValueError(f"kind must be 'form', 'placement' or 'design', got {kind!r}")

@@ -7,7 +7,7 @@ import pytest
 
 import barhinge as bh
 from barhinge.errors import PatternError
-from barhinge.pattern.subdivide import subdivided
+from barhinge.pattern.subdivide import subdivided, subdivided_size
 
 
 def _area(cp) -> float:
@@ -53,3 +53,34 @@ def test_pentagons_are_refused():
     )
     with pytest.raises(PatternError, match="5 corners"):
         subdivided(cp, 2)
+
+
+@pytest.mark.parametrize(
+    "cp",
+    [bh.families.miura(2, 2, fold=50.0), bh.families.yoshimura(3, 2, fold=20.0)],
+    ids=["quads", "triangles"],
+)
+@pytest.mark.parametrize("m", [1, 2, 3, 5])
+def test_subdivided_size_counts_what_subdivided_builds(cp, m):
+    out, _ = subdivided(cp, m)
+    n_quad = sum(len(f) == 4 for f in out.faces)
+    assert subdivided_size(cp, m) == (out.n_vertices, n_quad)
+    # and the N5B8 model of it has 3 (vertices + quadrilaterals) DOFs
+    model = bh.BarHingeModel.from_pattern(out, "N5B8")
+    assert 3 * model.n_nodes == 3 * sum(subdivided_size(cp, m))
+
+
+def test_subdivision_keeps_a_non_developable_pattern_non_developable():
+    """A formed (slightly non-developable) state can be refined: the flag is kept."""
+    from barhinge.pattern.crease import CreasePattern
+
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5]])
+    edges = [[0, 1], [1, 2], [2, 3], [3, 0], [0, 4], [1, 4], [2, 4], [3, 4]]
+    faces = [[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]]
+    flat = CreasePattern(sq, edges, ["B"] * 4 + ["V"] * 4, faces=faces)
+    X = np.column_stack([sq, np.zeros(5)])
+    X[4, 2] = 0.2  # a pyramid: the sector angles at the apex sum to less than 360 degrees
+    pyramid = flat.replaced(vertices=X, developable=False)
+    out, _ = subdivided(pyramid, 2)
+    assert out.developable is False
+    assert _area(out) == pytest.approx(_area(pyramid), rel=1e-12)

@@ -7,22 +7,15 @@ clamped-clamped beam, midspan deflection q L^4 / (384 E I); shear deflection q L
 
 from __future__ import annotations
 
-import importlib.util
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-RUN = Path(__file__).resolve().parents[2] / "studies" / "roofs" / "run.py"
-
 
 @pytest.fixture(scope="module")
-def study():
-    spec = importlib.util.spec_from_file_location("roofs_run", RUN)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)  # runs the quick mode at import
-    assert mod.QUICK
+def study(load_study):
+    mod = load_study("roofs/run.py", "roofs_run")  # runs the quick mode
     return mod
 
 

@@ -5,21 +5,14 @@ moves towards it under panel subdivision."""
 
 from __future__ import annotations
 
-import importlib.util
 import math
-from pathlib import Path
 
 import pytest
 
-RUN = Path(__file__).resolve().parents[2] / "studies" / "roofs" / "shell_check.py"
-
 
 @pytest.fixture(scope="module")
-def study():
-    spec = importlib.util.spec_from_file_location("roofs_shell_check", RUN)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)  # runs the quick mode at import
-    assert mod.QUICK
+def study(load_study):
+    mod = load_study("roofs/shell_check.py", "roofs_shell_check")  # runs the quick mode
     return mod
 
 
@@ -81,3 +74,18 @@ def test_extrapolation_refuses_a_sequence_outside_its_asymptotic_range(study) ->
     ref, p, unc = study.extrapolate([1439.1, 1334.3, 1233.9])
     assert p < study.MIN_ORDER
     assert ref == 1233.9 and math.isinf(unc)
+
+
+def test_main_rule_is_refined_past_the_fixed_levels(study) -> None:
+    """The main rule goes on refining while its stiffness still changes by 2 % or more and the
+    next level fits the DOF budget; the other rules keep their levels, and the table shows
+    the ragged levels with dashes."""
+    (r,) = study.RESULTS
+    main = [b["m"] for b in r["bar_hinge"][study.MAIN_RULE]]
+    assert main[: len(study.BH_LEVELS)] == study.BH_LEVELS and len(main) > len(study.BH_LEVELS)
+    assert max(b["n_dof"] for b in r["bar_hinge"][study.MAIN_RULE]) <= study.DOF_BUDGET
+    assert [b["m"] for b in r["bar_hinge"]["plate"]] == study.BH_LEVELS
+    text = study.table(study.RESULTS)
+    assert f"m = {main[-1]} |" in text
+    plate_row = next(line for line in text.splitlines() if "| plate |" in line)
+    assert plate_row.rstrip().split("|")[-3].strip() == "–"

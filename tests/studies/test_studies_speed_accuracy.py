@@ -7,21 +7,13 @@ closed-form rigidly folded Yoshimura arch of ``bh.families.yoshimura(fold=...)``
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-RUN = Path(__file__).resolve().parents[2] / "studies" / "speed_accuracy" / "run.py"
-
 
 @pytest.fixture(scope="module")
-def study():
-    spec = importlib.util.spec_from_file_location("speed_accuracy_run", RUN)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)  # runs the quick mode at import
-    assert mod.QUICK
+def study(load_study):
+    mod = load_study("speed_accuracy/run.py", "speed_accuracy_run")  # runs the quick mode
     return mod
 
 

@@ -57,9 +57,11 @@ def _form(pattern, kappa_L, model="rigid", curve="circle", ky_L=None, actuator_k
     return out
 
 
-def _recompute(transform, params: dict) -> dict:
+def _recompute(params: dict) -> dict:
+    import cells  # the study's sweep function (studies/transformations is on the path)
+
     prm = {k: v for k, v in params.items() if k != "kind"}
-    return transform.cell(params["kind"], quick=True, steps=6, **prm)
+    return cells.cell(params["kind"], quick=True, steps=6, **prm)
 
 
 def _check(res: dict, pub: dict) -> None:
@@ -99,12 +101,12 @@ def test_bar_and_hinge_converges_to_the_rigid_limit_as_one_over_r(run_mod) -> No
     distance to the rigid limit falls like 1/r (solver.md, rigid limit)."""
     mod, transform = run_mod
     for pattern, kl, tol in (("yoshimura", 1.0, 0.05), ("miura", 0.0, 0.15)):
-        rig = _recompute(transform, _form(pattern, kl))
+        rig = _recompute(_form(pattern, kl))
         _check(rig, _published(_form(pattern, kl)))
         assert rig["actuator_misfit_deg"] < 1e-6
         d = []
         for r in (100.0, 1000.0):
-            bh = _recompute(transform, _form(pattern, kl, r))
+            bh = _recompute(_form(pattern, kl, r))
             _check(bh, _published(_form(pattern, kl, r)))
             d.append(np.max(np.abs(np.asarray(bh["rho_deg"]) - rig["rho_deg"])))
         assert mod.slope([100.0, 1000.0], d) == pytest.approx(-1.0, abs=tol)
@@ -115,7 +117,7 @@ def test_rigid_miura_stays_flat_and_bends_into_a_saddle_only_by_straining(run_mo
     least squares (misfit > 0) and stays globally flat (K = 0); the bar-and-hinge model meets
     them by straining into a saddle (K < 0, Schenk & Guest 2013)."""
     _, transform = run_mod
-    rig = _recompute(transform, _form("miura", 1.0))
+    rig = _recompute(_form("miura", 1.0))
     _check(rig, _published(_form("miura", 1.0)))
     assert rig["actuator_misfit_deg"] > 1.0 and abs(rig["KL2"]) < 1e-9
     for r in (100.0, 1000.0):  # published only (6 s each)
@@ -128,7 +130,7 @@ def test_dof_placement_fixes_the_form_and_section_lines_do_not(run_mod) -> None:
     _, transform = run_mod
     for placement, fixed in (("dof", True), ("section", False)):
         p = {"kind": "placement", "pattern": "yoshimura", "count": 10, "placement": placement}
-        res = _recompute(transform, p)
+        res = _recompute(p)
         _check(res, _published(p))
         assert (res["form_error_deg"] < 1e-6) == fixed
 
@@ -139,7 +141,7 @@ def test_inverse_design_reaches_an_arch_and_says_why_a_miura_cannot_be_a_dome(ru
     _, transform = run_mod
     for pattern, k1, k2, reached in (("miura_arc", 0.0, -0.6, True), ("miura", -0.5, -0.5, False)):
         p = {"kind": "design", "pattern": pattern, "target_k1L": k1, "target_k2L": k2}
-        res = _recompute(transform, p)
+        res = _recompute(p)
         _check(res, _published(p))
         assert res["reached"] is reached
         assert (res["relative_error"] <= 0.05) is reached
@@ -156,13 +158,13 @@ def test_compliant_actuators_converge_to_the_rigid_limit_for_incompatible_target
     saddle of held actuators (K < 0) vanishes with it, K -> 0 (Schenk & Guest 2013)."""
     mod, transform = run_mod
     k = transform.COMPLIANT_K
-    rig = _recompute(transform, _form("miura", 1.0, actuator_k=k))
+    rig = _recompute(_form("miura", 1.0, actuator_k=k))
     _check(rig, _published(_form("miura", 1.0, actuator_k=k)))
     assert rig["actuator_misfit_deg"] > 1.0 and abs(rig["KL2"]) < 1e-9
     d, kl2 = [], []
     ratios = [1e4, 1e5]
     for r in ratios:
-        bh = _recompute(transform, _form("miura", 1.0, r, actuator_k=k))
+        bh = _recompute(_form("miura", 1.0, r, actuator_k=k))
         _check(bh, _published(_form("miura", 1.0, r, actuator_k=k)))
         d.append(np.max(np.abs(np.asarray(bh["rho_deg"]) - rig["rho_deg"])))
         kl2.append(abs(bh["KL2"]))

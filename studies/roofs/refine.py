@@ -1,0 +1,457 @@
+"""Every roof of the comparison refined until its stiffness changes by less than 2 %.
+
+For each roof of ``roofs.FAMILIES`` (every fold state of the comparison table) the
+bar-and-hinge model with every panel cut into ``m x m`` sub-panels
+(:func:`roofs.subdivided_roof`, the ``coupled`` plate rule, which converges to the Kirchhoff
+plate: docs/calibration.md, *Refined panels*) at m = 1, 2, 4, ...:
+
+* the linear stiffness ``k = Q_t^2 / (f . u)`` under the uniform load (as in the comparison
+  table) and ``k / width`` (width = plan area / span), with the equilibrium residual of the
+  solve (``|sum of reactions + loads| / |loads|``);
+* the first linear buckling factor under the design load (uniform load plus self-weight,
+  :func:`barhinge.analysis.buckling.linear_buckling`).
+
+A roof is *refined* at the first level whose stiffness differs from the previous level's by
+less than ``TOL`` in the sequence's asymptotic range (the change of the same sign as the one
+before and smaller, :func:`roofs.settled`: a sequence that turns can pass through a small
+change by chance). Refinement stops there, or before a level whose model would exceed
+``DOF_BUDGET`` DOFs (counted without building it, :func:`roofs.refinement_dofs`);
+a roof stopped by the budget is reported as not refined, with the Richardson limit of its
+last three levels and that extrapolation's correction as its uncertainty
+(:func:`barhinge.analysis.accuracy.richardson`).
+
+The ranking written with the table uses the refined stiffness and buckling factor, and the
+nonlinear check of the comparison table (arc length to the design load, one facet per panel,
+read from docs/roofs.csv, which ``run.py`` writes).
+
+Run: ``python studies/roofs/refine.py [--quick] [--publish] [--cache=FILE]``. Every level
+is written to the cache as soon as it is computed (default ``refine_cache.json`` beside this
+file, not versioned), so an interrupted run resumes where it stopped and ``--publish``
+re-derives the page from it. Importing the module runs the quick mode (two roofs, up to
+16 000 DOFs, nothing written); results at module level: ``RESULTS``.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+import roofs  # noqa: E402
+
+MAIN = __name__ == "__main__"
+QUICK = not MAIN or "--quick" in sys.argv
+PUBLISH = MAIN and "--publish" in sys.argv and not QUICK
+ROOT = HERE.parents[1]
+DOC = ROOT / "docs" / "roofs.md"
+CSV_MAIN = ROOT / "docs" / "roofs.csv"
+CSV_OUT = ROOT / "docs" / "roofs_refined.csv"
+START, END = "<!-- roofs-refined:start -->", "<!-- roofs-refined:end -->"
+
+#: refined when the stiffness changes by less than this between two levels (relative)
+TOL = roofs.REFINE_TOL
+#: the bending rule of the refinement
+RULE = "coupled"
+#: no level above this many DOFs is run
+DOF_BUDGET = 16_000 if QUICK else roofs.REFINE_DOF_BUDGET
+#: sub-panels per panel side, tried in order
+LEVELS = (1, 2, 4, 8, 16, 32, 64, 128)
+
+if QUICK:
+    ROOFS: list[tuple[str, float]] = [("pleats", 90.0), ("yoshimura", 20.0)]
+else:
+    ROOFS = [(f, float(s)) for f, spec in roofs.FAMILIES.items() for s in spec["states"]]
+
+_cache_arg = next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--cache=")), None)
+#: where the levels are kept (the quick mode keeps them in memory unless ``--cache`` is given)
+CACHE: Path | None = (
+    Path(_cache_arg) if _cache_arg else None if QUICK else HERE / "refine_cache.json"
+)
+
+
+def level(cp, sv: np.ndarray, se: np.ndarray, m: int) -> dict[str, Any]:
+    """One refinement level of a roof: stiffness, buckling factor, DOFs, wall time."""
+    from barhinge.analysis.buckling import linear_buckling
+    from barhinge.analysis.stiffness import linear_response
+    from barhinge.errors import BarhingeError
+    from barhinge.scene import self_weight
+
+    t0 = time.perf_counter()
+    model, S, residual = roofs.subdivided_roof(cp, sv, se, m, RULE)
+    Fq = roofs.plan_load(model, roofs.Q)
+    U, R = linear_response(model, Fq, S)
+    Qt = float(-Fq[:, 2].sum())
+    eq = float(np.linalg.norm(R.sum(0) + Fq.sum(0)) / np.linalg.norm(Fq.sum(0)))
+    t1 = time.perf_counter()
+    P = Fq + self_weight(model, roofs.DENSITY * roofs.MATERIAL["t"], g=(0.0, 0.0, -roofs.G))
+    try:
+        lam, why = float(linear_buckling(model, P, S, n_modes=1).factors[0]), ""
+    except BarhingeError as exc:
+        lam, why = float("nan"), str(exc).splitlines()[0]
+    return {
+        "m": m,
+        "n_dof": 3 * model.n_nodes,
+        "stiffness": Qt**2 / float(np.sum(Fq * U)),
+        "plan_area": Qt / roofs.Q,
+        "equilibrium_error": eq,
+        "buckling_factor": lam,
+        "buckling_error": why,
+        "patch_residual": residual,
+        "time_linear_s": t1 - t0,
+        "time_s": time.perf_counter() - t0,
+    }
+
+
+def change(rows: list[dict]) -> float:
+    """Relative change of the stiffness between the last two levels (NaN for one level)."""
+    if len(rows) < 2:
+        return float("nan")
+    return rows[-1]["stiffness"] / rows[-2]["stiffness"] - 1.0
+
+
+def refine(fam: str, state: float, done: list[dict], save=lambda rows: None) -> list[dict]:
+    """The levels of one roof: ``done`` (cached) extended until the stiffness changes by less
+    than ``TOL`` or the next level would exceed ``DOF_BUDGET``; ``save`` is called after every
+    new level."""
+    cp, flat_xy, _ = roofs.folded(fam, state)
+    sv, se = roofs.support_lines(cp, flat_xy, roofs.FAMILIES[fam]["axis"])
+    rows = list(done)
+    for m in LEVELS[len(rows) :]:
+        if roofs.settled([r["stiffness"] for r in rows], TOL):
+            break
+        if roofs.refinement_dofs(cp, m) > DOF_BUDGET:
+            break
+        rows.append(level(cp, sv, se, m))
+        save(rows)
+        r = rows[-1]
+        print(f"  {fam} {state:g} m = {m}: {r['n_dof']} DOF, k = {r['stiffness'] / 1e3:.1f} "
+              f"kN/m, change {100 * change(rows):+.2f} %, buckling {r['buckling_factor']:.3f}, "
+              f"{r['time_s']:.1f} s", flush=True)  # fmt: skip
+    return rows
+
+
+def summary(fam: str, state: float, rows: list[dict]) -> dict[str, Any]:
+    """A roof's refinement: the level it was refined to (or the budget), stiffness per width
+    there, the Richardson limit and its uncertainty, the buckling factors."""
+    from barhinge.analysis.accuracy import richardson
+
+    k = [r["stiffness"] for r in rows]
+    dk = change(rows)
+    refined = roofs.settled(k, TOL)
+    limit, rate, corr = richardson(k)
+    width = rows[-1]["plan_area"] / roofs.SPAN
+    return {
+        "family": fam,
+        "state": state,
+        "rows": rows,
+        "refined": refined,
+        "m": rows[-1]["m"],
+        "n_dof": rows[-1]["n_dof"],
+        "change": dk,
+        "stiffness": k[-1],
+        "stiffness_per_width": k[-1] / width,
+        "coarse_per_width": k[0] / width,
+        "limit_per_width": limit / width,
+        "limit_uncertainty": corr / limit if math.isfinite(corr) else math.inf,
+        "rate": rate,
+        "buckling_factor": rows[-1]["buckling_factor"],
+        "buckling_change": (
+            rows[-1]["buckling_factor"] / rows[-2]["buckling_factor"] - 1.0
+            if len(rows) >= 2
+            else float("nan")
+        ),
+        "coarse_buckling_factor": rows[0]["buckling_factor"],
+        "equilibrium_error": max(r["equilibrium_error"] for r in rows),
+        "patch_residual": max(r["patch_residual"] for r in rows),
+        "time_s": sum(r["time_s"] for r in rows),
+    }
+
+
+def _key(fam: str, state: float) -> str:
+    return f"{fam}|{state:g}"
+
+
+def run(roof_list: list[tuple[str, float]], cache: Path | None) -> list[dict]:
+    store: dict[str, list[dict]] = (
+        json.loads(cache.read_text()) if cache is not None and cache.exists() else {}
+    )
+    out = []
+    for fam, state in roof_list:
+        key = _key(fam, state)
+
+        def save(rows: list[dict], key: str = key) -> None:
+            store[key] = rows
+            if cache is not None:
+                cache.write_text(json.dumps(store, indent=0))
+
+        rows = refine(fam, state, store.get(key, []), save)
+        out.append(summary(fam, state, rows))
+    return out
+
+
+def main_table() -> dict[str, dict[str, str]]:
+    """The comparison table's rows (docs/roofs.csv, one facet per panel), by roof."""
+    if not CSV_MAIN.exists():
+        return {}
+    with CSV_MAIN.open() as fh:
+        return {_key(r["family"], float(r["state"])): r for r in csv.DictReader(fh)}
+
+
+def _f(x: float, spec: str = ".1f") -> str:
+    return "—" if x is None or not math.isfinite(x) else format(x, spec)
+
+
+def _pct(x: float) -> str:
+    return "—" if not math.isfinite(x) else f"{100 * x:+.1f} %"
+
+
+def _limit(r: dict) -> str:
+    if not math.isfinite(r["limit_uncertainty"]):
+        return "not settled"
+    return f"{r['limit_per_width'] / 1e3:.1f} ± {100 * r['limit_uncertainty']:.1f} %"
+
+
+def table(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
+    lines = [
+        "| family | state | refined to | DOFs | last change | k / width, refined (kN/m/m) | "
+        "limit (kN/m/m) | k / width, comparison table (kN/m/m) | table / refined − 1 | "
+        "buckling factor, refined | its last change | buckling factor, comparison table |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in results:
+        c = coarse.get(_key(r["family"], r["state"]))
+        kt = float(c["stiffness_per_width"]) if c else float("nan")
+        bt = float(c["buckling_factor"]) if c and c["buckling_factor"] else float("nan")
+        lvl = f"m = {r['m']}" if r["refined"] else f"not reached (m = {r['m']}, budget)"
+        lines.append(
+            f"| {r['family']} | {r['state']:g} | {lvl} | {r['n_dof']} | {_pct(r['change'])} | "
+            f"{r['stiffness_per_width'] / 1e3:.1f} | {_limit(r)} | {_f(kt / 1e3)} | "
+            f"{_pct(kt / r['stiffness_per_width'] - 1.0)} | {_f(r['buckling_factor'], '.3f')} | "
+            f"{_pct(r['buckling_change'])} | {_f(bt, '.3f')} |"
+        )
+    return "\n".join(lines)
+
+
+def stable(r: dict, c: dict[str, str] | None) -> tuple[bool, str]:
+    """(carries the design load, why not): the refined linear buckling factor above 1 and no
+    instability on the comparison table's nonlinear path."""
+    lam = r["buckling_factor"]
+    inst = c.get("instability_load_factor", "") if c else ""
+    why = []
+    if inst:
+        why.append(f"unstable at load factor {float(inst):.3f} on the nonlinear path")
+    if not math.isfinite(lam):
+        why.append("no linear buckling factor")
+    elif lam <= 1.0:
+        why.append(f"linear buckling factor {lam:.3f}")
+    return not why, "; ".join(why)
+
+
+#: families that are baselines, not roofs: left out of the ranking
+BASELINES = ("flat",)
+
+
+def ranking(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
+    roofs_only = [r for r in results if r["family"] not in BASELINES]
+    order = sorted(roofs_only, key=lambda r: -r["stiffness_per_width"])
+    ok, bad = [], []
+    for r in order:
+        st, why = stable(r, coarse.get(_key(r["family"], r["state"])))
+        label = f"{r['family']} {r['state']:g}"
+        k = f"k / width {r['stiffness_per_width'] / 1e3:.1f} kN/m/m"
+        k += "" if r["refined"] else f" (not refined: last change {_pct(r['change'])})"
+        if st:
+            ok.append(f"{len(ok) + 1}. {label}: {k}, linear buckling factor "
+                      f"{r['buckling_factor']:.3f}")  # fmt: skip
+        else:
+            bad.append(f"- {label}: {k}; {why}")
+    return "\n".join(
+        [
+            "Stiffest refined roofs that carry the design load (refined linear buckling factor"
+            " above 1, and no limit point or bifurcation below load factor 1 on the comparison"
+            " table's nonlinear path; the flat sheet, a baseline, is left out):",
+            "",
+            *(ok or ["(none)"]),
+            "",
+            "Roofs that are not stable up to the design load, by refined stiffness:",
+            "",
+            *(bad or ["(none)"]),
+        ]
+    )
+
+
+def findings(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
+    done = [r for r in results if r["refined"]]
+    open_ = [r for r in results if not r["refined"]]
+    ratio = [
+        float(coarse[_key(r["family"], r["state"])]["stiffness_per_width"])
+        / r["stiffness_per_width"]
+        for r in results
+        if _key(r["family"], r["state"]) in coarse
+    ]
+    by_fam: dict[str, list[dict]] = {}
+    for r in open_:
+        by_fam.setdefault(r["family"], []).append(r)
+    eq = max(r["equilibrium_error"] for r in results)
+    flips = [
+        r
+        for r in results
+        if _key(r["family"], r["state"]) in coarse
+        and stable(r, coarse[_key(r["family"], r["state"])])[0]
+        != _coarse_stable(coarse[_key(r["family"], r["state"])])
+    ]
+
+    def lab(r: dict) -> str:
+        return f"{r['family']} {r['state']:g}"
+
+    return "\n".join(
+        [
+            "What the refinement says:",
+            "",
+            f"1. **{len(done)} of {len(results)} roofs are refined** (stiffness change below "
+            f"{100 * TOL:g} % between the last two levels, at m = "
+            + ", ".join(sorted({str(r["m"]) for r in done}, key=int))
+            + f"); {len(open_)} reach the budget of {DOF_BUDGET:,} DOFs first"
+            + (
+                ": "
+                + "; ".join(
+                    f"{f} ({', '.join(format(r['state'], 'g') for r in rs)}: last change "
+                    f"{_pct(min(r['change'] for r in rs))} … {_pct(max(r['change'] for r in rs))})"
+                    for f, rs in by_fam.items()
+                )
+                if open_
+                else ""
+            )
+            + ". For those the table gives the Richardson limit of the last three levels with its"
+            " correction as the uncertainty; the panels' corners, where a folded sheet's"
+            " stresses are singular, set their slow convergence (*Against a shell model*,"
+            " finding 6).",
+            (
+                "2. **The one-facet comparison table is stiff.** Its k / width over the refined "
+                f"one: {min(ratio):.2f} … {max(ratio):.2f} (median {float(np.median(ratio)):.2f});"
+                " the refined figures are the ones to design with."
+                if ratio
+                else "2. The comparison table (docs/roofs.csv) is not there to compare with."
+            ),
+            "3. **Stability changes with refinement.** "
+            + (
+                "The verdict differs from the comparison table's for "
+                + ", ".join(lab(r) for r in flips)
+                + " (the table's linear buckling factor is that of one facet per panel)."
+                if flips
+                else "No roof changes its verdict against the comparison table's."
+            ),
+            f"4. Every solve balances: largest equilibrium residual {eq:.1e}.",
+        ]
+    )
+
+
+def _coarse_stable(c: dict[str, str]) -> bool:
+    lam = float(c["buckling_factor"]) if c["buckling_factor"] else float("nan")
+    return not c["instability_load_factor"] and not (math.isfinite(lam) and lam <= 1.0)
+
+
+def write_csv(results: list[dict], path: Path) -> None:
+    cols = ["family", "state", "m", "n_dof", "stiffness", "stiffness_per_width",
+            "buckling_factor", "equilibrium_error", "time_s"]  # fmt: skip
+    with path.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow([*cols, "refined"])
+        for r in results:
+            for row in r["rows"]:
+                width = row["plan_area"] / roofs.SPAN
+                vals = {**row, "family": r["family"], "state": r["state"],
+                        "stiffness_per_width": row["stiffness"] / width}  # fmt: skip
+                last = int(r["refined"] and row is r["rows"][-1])
+                w.writerow([f"{vals[c]:.6g}" if isinstance(vals[c], float) else vals[c]
+                            for c in cols] + [last])  # fmt: skip
+
+
+def chart(results: list[dict], path: Path) -> None:
+    """k / width and buckling factor against DOFs, one panel pair per family."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fams = [f for f in dict.fromkeys(r["family"] for r in results) if f not in BASELINES]
+    fig, axes = plt.subplots(2, len(fams), figsize=(2.6 * len(fams), 5.4), squeeze=False)
+    for j, fam in enumerate(fams):
+        for r in (r for r in results if r["family"] == fam):
+            n = [x["n_dof"] for x in r["rows"]]
+            w = r["rows"][-1]["plan_area"] / roofs.SPAN
+            ls = "-" if r["refined"] else "--"
+            axes[0, j].loglog(n, [x["stiffness"] / w / 1e3 for x in r["rows"]], "o" + ls, ms=3,
+                              label=f"{r['state']:g}")  # fmt: skip
+            axes[1, j].semilogx(n, [x["buckling_factor"] for x in r["rows"]], "o" + ls, ms=3)
+        axes[0, j].set_title(fam)
+        axes[0, j].legend(fontsize=6, title="state", title_fontsize=6)
+        axes[1, j].axhline(1.0, color="grey", lw=0.8, ls=":")
+        axes[1, j].set_xlabel("DOFs")
+        for ax in axes[:, j]:
+            ax.grid(True, which="both", alpha=0.3)
+    axes[0, 0].set_ylabel("k / width (kN/m/m)")
+    axes[1, 0].set_ylabel("linear buckling factor")
+    fig.suptitle("Refinement of every roof (coupled rule, m = 1, 2, 4, …; dashed: budget reached)",
+                 fontsize=9)  # fmt: skip
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def section(results: list[dict]) -> str:
+    coarse = main_table()
+    return "\n".join(
+        [
+            START,
+            "",
+            "Written by `python studies/roofs/refine.py --publish` (every level is kept in"
+            " `studies/roofs/refine_cache.json` as it is computed, so an interrupted run"
+            " resumes; data: [roofs_refined.csv](roofs_refined.csv))."
+            f" Every roof of the comparison table with each panel cut into m × m sub-panels"
+            f" (`{RULE}` plate rule), m = 1, 2, 4, … until the stiffness changes by less than"
+            f" {100 * TOL:g} % between two levels (a change of the same sign as the one before"
+            f" and smaller), or up to {DOF_BUDGET:,} DOFs. Stiffness and"
+            " width as in the comparison table (uniform load only); buckling factor under"
+            " the uniform load plus self-weight; limit = Richardson over the last three"
+            " levels (± its correction; *not settled* where the changes do not shrink).",
+            "",
+            "![refinement of every roof](img/roofs_refined.png)",
+            "",
+            table(results, coarse),
+            "",
+            ranking(results, coarse),
+            "",
+            findings(results, coarse),
+            "",
+            END,
+        ]
+    )
+
+
+RESULTS = run(ROOFS, CACHE)
+
+if MAIN:
+    text = section(RESULTS)
+    print(text)
+    if PUBLISH:
+        doc = DOC.read_text()
+        if START in doc:
+            a, b = doc.index(START), doc.index(END) + len(END)
+            doc = doc[:a] + text + doc[b:]
+        else:
+            at = doc.find("## Independent check: the corrugated roof")
+            head = "## Refined: every roof until its stiffness settles\n\n" + text + "\n\n"
+            doc = doc[:at] + head + doc[at:] if at >= 0 else doc.rstrip("\n") + "\n\n" + head
+        DOC.write_text(doc)
+        chart(RESULTS, DOC.parent / "img" / "roofs_refined.png")
+        write_csv(RESULTS, CSV_OUT)
+        print(f"wrote {DOC}, {CSV_OUT}")

@@ -1,0 +1,87 @@
+"""The roofs' refinement study in its quick mode (studies/roofs/refine.py): levels stop at the
+2 % criterion or the DOF budget, every solve balances its load, an interrupted run resumes
+from its cache, and the ranking states every roof's stability once."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+
+@pytest.fixture(scope="module")
+def study(load_study):
+    mod = load_study("roofs/refine.py", "roofs_refine")  # runs the quick mode
+    assert mod.CACHE is None  # the quick mode writes nothing
+    return mod
+
+
+def test_levels_stop_at_the_criterion_or_the_budget(study) -> None:
+    from barhinge.pattern.subdivide import subdivided_size
+
+    for r in study.RESULTS:
+        ms = [x["m"] for x in r["rows"]]
+        assert ms == list(study.LEVELS[: len(ms)])
+        assert max(x["n_dof"] for x in r["rows"]) <= study.DOF_BUDGET
+        k = [x["stiffness"] for x in r["rows"]]
+        if r["refined"]:
+            assert abs(r["change"]) < study.TOL and study.roofs.settled(k, study.TOL)
+            assert not study.roofs.settled(k[:-1], study.TOL)  # it stopped at the first one
+        else:  # the next level would not fit
+            cp, _, _ = study.roofs.folded(r["family"], r["state"])
+            assert 3 * sum(subdivided_size(cp, 2 * ms[-1])) > study.DOF_BUDGET
+            assert not study.roofs.settled(k, study.TOL)
+
+
+def test_every_level_balances_its_load(study) -> None:
+    for r in study.RESULTS:
+        assert r["equilibrium_error"] < 1e-8
+        plan = {round(x["plan_area"], 9) for x in r["rows"]}
+        assert len(plan) == 1  # every level carries the same load
+
+
+def test_loose_tolerance_stops_at_the_first_settled_level(study, monkeypatch) -> None:
+    """With a loose tolerance the pleats (whose stiffness rises by shrinking changes) settle
+    as soon as two changes exist."""
+    monkeypatch.setattr(study, "TOL", 10.0)
+    rows = study.refine("pleats", 90.0, [])
+    assert [x["m"] for x in rows] == [1, 2, 4]
+    assert study.summary("pleats", 90.0, rows)["refined"]
+
+
+@pytest.mark.parametrize(
+    ("k", "expect"),
+    [
+        ([100.0, 90.0, 89.0], True),  # -10 %, -1.1 %: settled
+        ([503.1, 549.2, 547.1], False),  # +9.2 %, -0.4 %: turned, small by chance
+        ([100.0, 99.0, 97.0], False),  # -1 %, -2 %: the changes grow
+        ([100.0, 99.0, 98.9], True),
+        ([100.0, 99.9], False),  # one change says nothing about the trend
+    ],
+)
+def test_settled_needs_a_small_change_in_the_asymptotic_range(study, k, expect) -> None:
+    assert study.roofs.settled(k, 0.02) is expect
+
+
+def test_interrupted_run_resumes_from_its_cache(study, tmp_path, monkeypatch) -> None:
+    cache = tmp_path / "levels.json"
+    first = study.run([("pleats", 90.0)], cache)
+    stored = json.loads(cache.read_text())
+    assert [x["m"] for x in stored["pleats|90"]] == [x["m"] for x in first[0]["rows"]]
+
+    def no_new_level(*args, **kwargs):
+        raise AssertionError("a cached level was computed again")
+
+    monkeypatch.setattr(study, "level", no_new_level)
+    again = study.run([("pleats", 90.0)], cache)
+    assert again[0]["stiffness"] == first[0]["stiffness"]
+
+
+def test_ranking_states_every_roof_once(study) -> None:
+    text = study.ranking(study.RESULTS, {})
+    for r in study.RESULTS:  # the quick roofs are no baselines
+        label = f"{r['family']} {r['state']:g}:"
+        assert text.count(label) == 1
+        ok, why = study.stable(r, None)
+        assert ok == (r["buckling_factor"] > 1.0)
+        assert ok or "linear buckling factor" in why
