@@ -407,7 +407,7 @@ def refinement_dofs(cp, m: int) -> int:
 
 def subdivided_roof(
     cp, sv: np.ndarray, se: np.ndarray, m: int, rule: str = "coupled", scheme: str = "N5B8",
-    material: Any = None,
+    sheet: Any = None,
 ) -> tuple[Any, np.ndarray, float]:  # fmt: skip
     """A roof's bar-and-hinge model with every panel cut into ``m x m`` sub-panels.
 
@@ -417,7 +417,7 @@ def subdivided_roof(
         (:func:`support_lines`)
     m : sub-panels per panel side (1: the panels as they are)
     rule : a key of ``BENDING_RULES``
-    material : the sheet (default: the study's)
+    sheet : Material, the sheet (default: the study's, :func:`material`)
 
     Returns
     -------
@@ -434,7 +434,7 @@ def subdivided_roof(
     if rule not in BENDING_RULES:
         raise ValueError(f"bending rule {rule!r}; expected one of {sorted(BENDING_RULES)}")
     cpm, parent = subdivided(cp, m)
-    mat = material if material is not None else globals()["material"]()
+    mat = material() if sheet is None else sheet
     model = bh.BarHingeModel.from_pattern(cpm, scheme, mat, **BENDING_RULES[rule])
     residual = 0.0
     if rule == "coupled":
