@@ -431,7 +431,8 @@ def coupled_bending(model: BarHingeModel) -> BarHingeModel:
         K = np.array([s[0] for s in shapes])[inv]  # (nf, n, n) / D
         residual[fids] = np.array([s[1] for s in shapes])[inv]
         # angle rows per cell: the representative's, scaled to the cell (rows ~ length)
-        rows = np.array([_cell_rows(P2[f], w)[0] for f, w in zip(first, cell_wings, strict=True)])[inv]
+        reps = zip(first, cell_wings, strict=True)
+        rows = np.array([_cell_rows(P2[f], w)[0] for f, w in reps])[inv]
         rows = rows * np.sqrt(area / area[first][inv])[:, None, None]
         valid = hid >= 0
         plate_like = valid & ~crease[np.maximum(hid, 0)]
