@@ -76,6 +76,7 @@ else:
         ("pleats", 90.0),
         ("pleats", 60.0),
         ("miura_arc", 60.0),
+        ("miura75", 75.0),
     ]
     BH_LEVELS, SHELL_LEVELS = [1, 2, 4, 8, 16], [1, 2, 3, 4, 5]
     LEVELS = {
