@@ -145,6 +145,12 @@ def _f(x: float) -> str:
     return "–" if not np.isfinite(x) else f"{x:+.3f}".replace("-0.000", "+0.000")
 
 
+def _modes_row(head: list[str], r: dict) -> str:
+    """A table row: ``head`` cells, the four modes' errors, the worst."""
+    worst = max(abs(r[m]) for m in MODES)
+    return "| " + " | ".join([*head, *(_f(r[m]) for m in MODES), f"{worst:.3f}"]) + " |"
+
+
 def render(mrows: list[dict], brows: list[dict], rrows: list[dict] | None = None) -> str:
     out = [
         generated_stamp("python scripts/calibration_table.py"),
@@ -170,12 +176,7 @@ def render(mrows: list[dict], brows: list[dict], rrows: list[dict] | None = None
         "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in mrows:
-        worst = max(abs(r[m]) for m in MODES)
-        out.append(
-            f"| {r['shape']} | {r['scheme']} | {r['nu']:g} | {r['rule']} | "
-            + " | ".join(_f(r[m]) for m in MODES)
-            + f" | {worst:.3f} |"
-        )
+        out.append(_modes_row([r["shape"], r["scheme"], f"{r['nu']:g}", r["rule"]], r))
     out += [
         "",
         "### Table 2 — corner warping against the Morley plate, per bending rule",
@@ -199,12 +200,7 @@ def render(mrows: list[dict], brows: list[dict], rrows: list[dict] | None = None
             "| shape | m | dilation | uniax. x | uniax. y | shear | worst |",
             "|---|---|---|---|---|---|---|",
         ]
-        for r in rrows:
-            worst = max(abs(r[m]) for m in MODES)
-            out.append(
-                f"| {r['shape']} | {r['m']} | " + " | ".join(_f(r[m]) for m in MODES)
-                + f" | {worst:.3f} |"
-            )  # fmt: skip
+        out += [_modes_row([r["shape"], str(r["m"])], r) for r in rrows]
     return "\n".join(out) + "\n"
 
 
