@@ -220,6 +220,41 @@ def _bounded_fits(G: np.ndarray, y: np.ndarray, a_min: np.ndarray) -> np.ndarray
     return out[inv.ravel()] * a_min[:, None]
 
 
+def _half_diagonal_ties(
+    bars: np.ndarray, faces: tuple, fids: np.ndarray, n_vertices: int
+) -> np.ndarray | None:
+    """(nf, 2, 2) column pairs ``[[i0, i2], [i1, i3]]`` of the half-diagonal bars of each N5B8
+    quad (bars (nf, m, 2) per face, the centre node ``>= n_vertices``): the half-bars to
+    corners 0 and 2, and to corners 1 and 3. None unless every face is such a quad."""
+    F = np.array([faces[f] for f in fids], dtype=np.int64)
+    if F.shape[1] != 4:
+        return None
+    hub = (bars >= n_vertices).any(axis=2)  # (nf, m)
+    if not (hub.sum(axis=1) == 4).all():
+        return None
+    corner = np.where(bars[..., 0] >= n_vertices, bars[..., 1], bars[..., 0])  # (nf, m)
+    # column of the half-bar to each corner position k
+    at = (corner[:, None, :] == F[:, :, None]) & hub[:, None, :]  # (nf, 4, m)
+    if not (at.sum(axis=2) == 1).all():
+        return None
+    col = np.argmax(at, axis=2)  # (nf, 4)
+    return np.stack([col[:, [0, 2]], col[:, [1, 3]]], axis=1)
+
+
+def _tie_matrix(tie: np.ndarray, m: int) -> np.ndarray:
+    """(nf, m, m - 2): bar areas from the tied unknowns (each half-diagonal pair one)."""
+    nf = len(tie)
+    T = np.zeros((nf, m, m))
+    T[:, np.arange(m), np.arange(m)] = 1.0
+    rows = np.arange(nf)
+    for p in range(2):
+        T[rows, tie[:, p, 1], tie[:, p, 0]] = 1.0  # the second half follows the first
+    drop = np.sort(tie[:, :, 1], axis=1)  # columns of the followers: removed
+    keep = np.ones((nf, m), dtype=bool)
+    keep[rows[:, None], drop] = False
+    return T.transpose(0, 2, 1)[keep].reshape(nf, m - 2, m).transpose(0, 2, 1)
+
+
 def bar_areas(
     cp: CreasePattern,
     tri: Triangulation,
@@ -270,8 +305,27 @@ def bar_areas(
             y = np.concatenate([y, (y @ dil)[:, None]], axis=1)
         sol = np.einsum("nmr,nr->nm", np.linalg.pinv(G), y)
         a_min = MIN_AREA_FRACTION * material.t * A / topo_lengths(X, topo.bars[bar_ids])
+        tie = _half_diagonal_ties(topo.bars[bar_ids], faces, fids, len(cp.vertices))
         bad = np.flatnonzero((sol < a_min[:, None]).any(axis=1))
         if len(bad):
             sol[bad] = _bounded_fits(G[bad], y[bad], a_min[bad])
+        if tie is not None:
+            # a diagonal's two half-bars get one area, so that the centre node is in
+            # equilibrium under every uniform strain (triangulate.quad_centres); the fit
+            # already gives it (to round-off) where the panel is point-symmetric
+            pair = np.take_along_axis(sol, tie[:, :, 0], 1) - np.take_along_axis(
+                sol, tie[:, :, 1], 1
+            )
+            uneq = np.flatnonzero(np.abs(pair).max(axis=1) > 1e-9 * np.abs(sol).max(axis=1))
+            if len(uneq):
+                T = _tie_matrix(tie[uneq], m)
+                Gt = np.einsum("nrm,nmk->nrk", G[uneq], T)
+                st = np.einsum("nkr,nr->nk", np.linalg.pinv(Gt), y[uneq])
+                low = np.flatnonzero(
+                    (np.einsum("nmk,nk->nm", T, st) < a_min[uneq, None]).any(axis=1)
+                )
+                if len(low):
+                    st[low] = _bounded_fits(Gt[low], y[uneq][low], a_min[uneq][low])
+                sol[uneq] = np.einsum("nmk,nk->nm", T, st)
         np.add.at(area, bar_ids.ravel(), np.maximum(sol, 0.0).ravel())
     return area

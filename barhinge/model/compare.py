@@ -20,7 +20,7 @@ from barhinge.model.material import Material
 from barhinge.model.model import BarHingeModel
 from barhinge.pattern.crease import CreasePattern
 
-__all__ = ["panel_errors", "rectangle_edge_load_error"]
+__all__ = ["panel_errors", "rectangle_edge_load_error", "subdivided_membrane_errors"]
 
 
 def panel_errors(
@@ -54,6 +54,37 @@ def panel_errors(
         pre[:, :2] = 0.0
         pre[:k, 2] = w
         out["warp"] = panel_energy(m, pre) / plate_corner_energy(P, material, w, plate_refine) - 1
+    return out
+
+
+def subdivided_membrane_errors(
+    P: np.ndarray,
+    material: Material,
+    m: int,
+    scheme: str = "N5B8",
+    bar_calibration: str = "fit",
+) -> dict[str, float]:
+    """Relative energy errors ``U_bar / U_continuum - 1`` of the panel ``P`` (k, 2) cut into
+    ``m x m`` cells (:func:`barhinge.pattern.subdivide.subdivided`) under the homogeneous
+    membrane modes: the displacements ``eps x`` prescribed on the panel's boundary, every
+    inner node free (the membrane patch test of the refined panel)."""
+    from barhinge.pattern.subdivide import subdivided
+
+    P = np.asarray(P, float)
+    k = len(P)
+    cp = CreasePattern(P, [[i, (i + 1) % k] for i in range(k)], ["B"] * k, faces=[list(range(k))])
+    cpm, _ = subdivided(cp, m)
+    model = BarHingeModel.from_pattern(cpm, scheme, material, bar_calibration=bar_calibration)
+    X = np.asarray(model.X0)[:, :2]
+    E = np.asarray(cpm.edges)
+    on_boundary = np.zeros(model.n_nodes, bool)
+    on_boundary[E[np.asarray(cpm.boundary_edges)].ravel()] = True
+    out: dict[str, float] = {}
+    for name, eps in strain_modes(material.nu).items():
+        pre = np.full((model.n_nodes, 3), np.nan)
+        pre[:, 2] = 0.0
+        pre[on_boundary, :2] = X[on_boundary] @ eps.T
+        out[name] = panel_energy(model, pre) / homogeneous_energy(P, material, eps) - 1.0
     return out
 
 

@@ -45,6 +45,7 @@ import numpy as np
 
 from barhinge.errors import ConfigError
 from barhinge.model.model import BarHingeModel
+from barhinge.model.triangulate import quad_centres
 
 logger = logging.getLogger(__name__)
 
@@ -101,15 +102,22 @@ def _angle_row(a, b, wings, da: float = 0.0, db: float = 0.0) -> np.ndarray:
     return g
 
 
-def _cell_rows(P: np.ndarray):
+def _cell_rows(P: np.ndarray, wings: np.ndarray | None = None):
     """Angle rows, energy weights and groups of a cell's hinges, in the order: quad: side i
-    (P_i -> P_i+1) for i = 0..3, then half-diagonal P_i -> centre; triangle: side i."""
+    (P_i -> P_i+1) for i = 0..3, then half-diagonal P_i -> centre; triangle: side i.
+
+    ``wings`` (4, 2), quads only: the neighbour cell's centre node across each side, in the
+    cell's plane; by default (and where a row is NaN) the point reflection of the cell's own
+    centre through the side's midpoint (exact on a grid of equal parallelograms)."""
     rows, w, grp = [], [], []
     if len(P) == 4:
-        c = P.mean(axis=0)
+        c = quad_centres(P)  # the model's centre node (triangulate: where the diagonals cross)
         for i in range(4):
             a, b = P[i], P[(i + 1) % 4]
-            rows.append(_angle_row(a, b, [(c, 1.0), (a + b - c, 1.0)]))
+            nb = a + b - c
+            if wings is not None and np.isfinite(wings[i]).all():
+                nb = wings[i]
+            rows.append(_angle_row(a, b, [(c, 1.0), (nb, 1.0)]))
             w.append(0.5)
             grp.append(i % 2)
         for i in range(4):
@@ -172,16 +180,21 @@ def cell_fit(P: np.ndarray, nu: float) -> tuple[np.ndarray, float, float]:
     return sol.x[:ng][grp], float(sol.x[ng]), float(np.abs(mismatch(sol.x)).max())
 
 
-def _cells_2d(X: np.ndarray, F: np.ndarray) -> np.ndarray:
-    """(nf, k, 2) corners of the faces F (nf, k) in their own planes (origin corner 0,
-    first axis along side 0)."""
+def _cell_frames(X: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(origin, e1, e2), each (nf, 3): the planes of the faces F (nf, k): origin corner 0,
+    first axis along side 0."""
     P = X[F]
     n = np.cross(P, np.roll(P, -1, axis=1)).sum(axis=1)
     n /= np.linalg.norm(n, axis=1)[:, None]
     e1 = P[:, 1] - P[:, 0]
     e1 /= np.linalg.norm(e1, axis=1)[:, None]
-    e2 = np.cross(n, e1)
-    R = P - P[:, :1]
+    return P[:, 0], e1, np.cross(n, e1)
+
+
+def _cells_2d(X: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """(nf, k, 2) corners of the faces F (nf, k) in their own planes (:func:`_cell_frames`)."""
+    origin, e1, e2 = _cell_frames(X, F)
+    R = X[F] - origin[:, None]
     return np.stack([np.einsum("fki,fi->fk", R, e1), np.einsum("fki,fi->fk", R, e2)], axis=-1)
 
 
@@ -283,7 +296,9 @@ def consistent_bending(model: BarHingeModel) -> BarHingeModel:
     return model.with_(hinge_k=consistent_hinge_stiffness(model).hinge_k)
 
 
-def cell_matrix(P: np.ndarray, nu: float) -> tuple[np.ndarray, float]:
+def cell_matrix(
+    P: np.ndarray, nu: float, wings: np.ndarray | None = None
+) -> tuple[np.ndarray, float]:
     """Energy matrix over D of one flat cell's hinge angles, with couplings (the sheet's nu).
 
     The cell stores ``theta^T K theta D / 2`` (``theta`` its hinge angles in the order of
@@ -306,7 +321,7 @@ def cell_matrix(P: np.ndarray, nu: float) -> tuple[np.ndarray, float]:
     residual : float, largest |entry| of the condensed mismatch / D (round-off when exact)
     """
     P = np.asarray(P, float)
-    rows, w, grp = _cell_rows(P)
+    rows, w, grp = _cell_rows(P, wings)
     area = 0.5 * abs(float(np.sum(P[:, 0] * np.roll(P[:, 1], -1) - np.roll(P[:, 0], -1) * P[:, 1])))
     plate = area * np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 2.0 * (1.0 - nu)]])
     if len(P) == 3:
@@ -384,18 +399,41 @@ def coupled_bending(model: BarHingeModel) -> BarHingeModel:
     residual = np.zeros(cp.n_faces)
     worst = 0.0
     for size, fids, F, P2, area, first, inv in _cell_groups(cp, X):
-        shapes = [cell_matrix(P2[f], nu) for f in first]
-        K = np.array([s[0] for s in shapes])[inv]  # (nf, n, n) / D
-        residual[fids] = np.array([s[1] for s in shapes])[inv]
-        # angle rows per cell: the representative's, scaled to the cell (rows ~ length)
-        rows = np.array([_cell_rows(P2[f])[0] for f in first])[inv]  # (nf, n, 4)
-        rows = rows * np.sqrt(area / area[first][inv])[:, None, None]
         # model hinge of every cell hinge: sides, then (quads) the half-diagonals
         a, b = F, np.roll(F, -1, axis=1)
         e = eorder[np.searchsorted(ekey, np.minimum(a, b) * nv + np.maximum(a, b), sorter=eorder)]
         hid = hinge_of_edge[e]  # (nf, size), -1 on boundary edges
+        wings = None
         if size == 4:
-            hid = np.concatenate([hid, _diagonal_hinges(model, fids, F)], axis=1)
+            diag_hid = _diagonal_hinges(model, fids, F)
+            # the neighbour's centre node across every flat side, in the cell's plane: the
+            # grid need not be point-symmetric (quads' centres sit where their diagonals cross)
+            own = np.maximum(h[diag_hid[:, 0], 0], h[diag_hid[:, 0], 1])  # centre node
+            side = np.maximum(hid, 0)
+            wing = np.where(h[side, 2] == own[:, None], h[side, 3], h[side, 2])  # (nf, 4)
+            origin, e1, e2 = _cell_frames(X, F)
+            R = X[wing] - origin[:, None]
+            wings = np.stack(
+                [np.einsum("fki,fi->fk", R, e1), np.einsum("fki,fi->fk", R, e2)], axis=-1
+            )
+            wings[~((hid >= 0) & flat_line[side])] = np.nan
+            scale = np.sqrt(area)[:, None, None]
+            key = np.round(
+                np.concatenate([P2, np.nan_to_num(wings, nan=1e9)], 1) / scale, SHAPE_DIGITS
+            )
+            _, first, inv = np.unique(
+                key.reshape(len(fids), -1), axis=0, return_index=True, return_inverse=True
+            )
+            inv = inv.ravel()
+            hid = np.concatenate([hid, diag_hid], axis=1)
+        cell_wings = [None if wings is None else wings[f] for f in first]
+        shapes = [cell_matrix(P2[f], nu, w) for f, w in zip(first, cell_wings, strict=True)]
+        K = np.array([s[0] for s in shapes])[inv]  # (nf, n, n) / D
+        residual[fids] = np.array([s[1] for s in shapes])[inv]
+        # angle rows per cell: the representative's, scaled to the cell (rows ~ length)
+        reps = zip(first, cell_wings, strict=True)
+        rows = np.array([_cell_rows(P2[f], w)[0] for f, w in reps])[inv]
+        rows = rows * np.sqrt(area / area[first][inv])[:, None, None]
         valid = hid >= 0
         plate_like = valid & ~crease[np.maximum(hid, 0)]
         sign, mismatch = _angle_signs(X, F, h, grad, np.where(plate_like, hid, -1), rows)

@@ -2,9 +2,14 @@
 
 * triangles are kept as they are;
 * quadrilaterals by ``N4B5`` (split along the shorter diagonal, which becomes a bending
-  hinge; corners 0-2 when the two are equal to round-off) or ``N5B8`` (a centre node at the
-  mean of the four corners joined to them: 8 bars, 4 bending hinges) -- Filipov et al.
-  (2017, IJSS, Fig. 5);
+  hinge; corners 0-2 when the two are equal to round-off) or ``N5B8`` (a centre node joined
+  to the four corners: 8 bars, 4 bending hinges) -- Filipov et al. (2017, IJSS, Fig. 5).
+  The centre node sits where the two diagonals cross (:func:`quad_centres`), so that each
+  diagonal's two half-bars are collinear: under any uniform in-plane strain the centre node is
+  then in equilibrium when they have equal stiffness (``calibrate.bar_areas`` ties them), and
+  the panel stores the membrane energy its bars were fitted to. At the corners' mean (the
+  same point for a parallelogram) the centre node of a trapezoid relaxes under uniform strain:
+  a refined arched-Miura panel kept 16-54 % of its membrane stiffness across one direction;
 * polygons with more than four corners by a centre node (mean of the corners) joined to every
   corner, in both schemes.
 
@@ -22,7 +27,7 @@ from barhinge._typing import SCHEMES, Scheme
 from barhinge.errors import ConfigError, PatternError
 from barhinge.pattern.crease import CreasePattern
 
-__all__ = ["Triangulation", "triangulate"]
+__all__ = ["Triangulation", "quad_centres", "triangulate"]
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -47,12 +52,44 @@ class Triangulation:
     centre_face: np.ndarray
 
 
+def quad_centres(P: np.ndarray) -> np.ndarray:
+    """(..., d) centre points of quadrilaterals ``P`` (..., 4, d), d = 2 or 3: where the
+    diagonals 0-2 and 1-3 cross (in a non-planar quad, the midpoint of their common
+    perpendicular).
+
+    Written as the corners' mean plus a correction proportional to the quad's departure from
+    a parallelogram, ``g = P0 + P2 - P1 - P3``, so that a parallelogram's centre is its mean
+    to the last bit. Where the crossing falls outside either diagonal (a non-convex quad) or
+    the diagonals are parallel, the mean is kept.
+    """
+    P = np.asarray(P, dtype=float)
+    mean = P.mean(axis=-2)
+    d1 = P[..., 2, :] - P[..., 0, :]
+    d2 = P[..., 3, :] - P[..., 1, :]
+    g = P[..., 0, :] + P[..., 2, :] - P[..., 1, :] - P[..., 3, :]
+    a = np.einsum("...i,...i->...", d1, d1)
+    b = np.einsum("...i,...i->...", d1, d2)
+    c = np.einsum("...i,...i->...", d2, d2)
+    det = a * c - b * b
+    ok = det > 1e-12 * a * c
+    det = np.where(ok, det, 1.0)
+    # closest points P0 + (1/2 + s) d1 and P1 + (1/2 + t) d2: [-d1 d2] [s t] = g / 2
+    rg1 = -0.5 * np.einsum("...i,...i->...", d1, g)
+    rg2 = 0.5 * np.einsum("...i,...i->...", d2, g)
+    s = (c * rg1 + b * rg2) / det
+    t = (b * rg1 + a * rg2) / det
+    ok &= (np.abs(s) < 0.5) & (np.abs(t) < 0.5)
+    shift = 0.5 * (s[..., None] * d1 + t[..., None] * d2)
+    return np.where(ok[..., None], mean + shift, mean)
+
+
 def triangulate(cp: CreasePattern, scheme: Scheme = "N5B8") -> Triangulation:
     """Triangulate every face of ``cp`` with ``scheme`` (``"N4B5"`` or ``"N5B8"``).
 
     The geometry used (shorter diagonal, centre nodes) is the pattern's current state
-    ``cp.vertices3d``; a centre node is the mean of its face's corners, so in a folded,
-    non-planar quad the rest angles of its bending hinges take up the state.
+    ``cp.vertices3d``; a quadrilateral's centre node is where its diagonals cross
+    (:func:`quad_centres`), a larger polygon's the mean of its corners, so in a folded,
+    non-planar face the rest angles of its bending hinges take up the state.
     """
     if scheme not in SCHEMES:
         raise ConfigError(f"scheme {scheme!r} is unknown; expected one of {', '.join(SCHEMES)}")
@@ -83,7 +120,7 @@ def triangulate(cp: CreasePattern, scheme: Scheme = "N5B8") -> Triangulation:
             continue
         c = next_node + np.arange(len(fid))
         next_node += len(fid)
-        centres.append(V[F].mean(axis=1))
+        centres.append(quad_centres(V[F]) if k == 4 else V[F].mean(axis=1))
         cface.append(fid)
         T = np.empty((len(fid), k, 3), dtype=np.int64)
         T[:, :, 0] = F

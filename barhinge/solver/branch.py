@@ -31,7 +31,7 @@ from barhinge._protocols import SolverModel
 from barhinge.actuators import Actuators
 from barhinge.errors import BarhingeError, ConvergenceError
 from barhinge.kinematics.path import RigidOptions, actuator_conflict, rigid_fold
-from barhinge.model.triangulate import triangulate
+from barhinge.model.triangulate import quad_centres, triangulate
 
 __all__ = [
     "RigidGuide",
@@ -68,8 +68,10 @@ def fold_weights(model: SolverModel) -> tuple[np.ndarray, float]:
 
 
 def _node_coordinates(model: SolverModel, V: np.ndarray) -> np.ndarray:
-    """(n_nodes, 3) model nodes from pattern vertices ``V``: centre nodes at the mean of
-    their face's corners. ``V`` may hold many states, (n_states, n_vertices, 3)."""
+    """(n_nodes, 3) model nodes from pattern vertices ``V``: centre nodes placed as
+    :func:`~barhinge.model.triangulate.triangulate` places them (quads: where the diagonals
+    cross; larger polygons: the corners' mean). ``V`` may hold many states,
+    (n_states, n_vertices, 3)."""
     V = np.asarray(V, dtype=float)
     cp = model.pattern
     if int(model.n_nodes) == cp.n_vertices:
@@ -77,10 +79,14 @@ def _node_coordinates(model: SolverModel, V: np.ndarray) -> np.ndarray:
     centre_face = triangulate(cp, model.scheme).centre_face
     corners = [cp.faces[f] for f in centre_face]
     sizes = np.fromiter((len(c) for c in corners), dtype=np.int64, count=len(corners))
+    quad = sizes == 4
     cols = np.fromiter((i for c in corners for i in c), dtype=np.int64, count=int(sizes.sum()))
     rows = np.repeat(np.arange(len(corners)), sizes)
     mean = sp.csr_matrix((1.0 / sizes[rows], (rows, cols)), shape=(len(corners), cp.n_vertices))
     C = np.stack([mean @ v for v in V]) if V.ndim == 3 else mean @ V
+    if quad.any():
+        Q = np.array([corners[i] for i in np.flatnonzero(quad)], dtype=np.int64)
+        C[..., quad, :] = quad_centres(V[..., Q, :])
     return np.concatenate([V, C], axis=-2)
 
 

@@ -405,6 +405,30 @@ def refinement_dofs(cp, m: int) -> int:
     return 3 * sum(subdivided_size(cp, m))
 
 
+def cell_membrane_error(cp) -> float:
+    """Worst relative energy error of the bar lattice under a uniform membrane strain, over the
+    homogeneous modes and the distinct face shapes of ``cp`` (one N5B8 panel each, the sheet's
+    material; :func:`barhinge.model.compare.panel_errors`). A panel cut into cells keeps its
+    shape's error (Table 4 of docs/calibration.md), so refinement converges to a sheet whose
+    membrane is off by about this much in its worst direction."""
+    from barhinge.model.compare import panel_errors
+
+    X = np.asarray(cp.vertices3d, float)
+    shapes: dict[tuple, np.ndarray] = {}
+    for f in cp.faces:
+        P = X[list(f)]
+        e1 = (P[1] - P[0]) / np.linalg.norm(P[1] - P[0])
+        n = np.cross(P, np.roll(P, -1, axis=0)).sum(axis=0)
+        e2 = np.cross(n / np.linalg.norm(n), e1)
+        Q = np.column_stack([(P - P[0]) @ e1, (P - P[0]) @ e2])
+        shapes.setdefault(tuple(np.round(Q / np.abs(Q).max(), 6).ravel()), Q)
+    worst = 0.0
+    for Q in shapes.values():
+        e = panel_errors(Q, material(), "N5B8", "fit", plate_refine=1)
+        worst = max(worst, max(abs(v) for k, v in e.items() if k != "warp"))
+    return worst
+
+
 def subdivided_roof(
     cp, sv: np.ndarray, se: np.ndarray, m: int, rule: str = "coupled", scheme: str = "N5B8",
     sheet: Any = None,

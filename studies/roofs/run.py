@@ -253,11 +253,18 @@ def findings() -> str:
     if len(arc) >= 2:
         a, b = arc[0], arc[-1]
         strain = max(r["peak_strain"] for r in arc)
+        top = max(RESULTS, key=lambda r: r["peak_strain"])
+        where = (
+            "the largest of the study"
+            if top["family"] == "miura_arc"
+            else f"the study's largest is {top['peak_strain']:.1e} ({top['family']} "
+            f"{top['state']:g})"
+        )
         out.append(
             f"4. **The arched Miura** is soft at a small fold (its corrugation runs across the "
             f"arch, so the arch bends) and stiffens × {kw[id(b)] / kw[id(a)]:.0f} from "
             f"{a['state']:g}° to {b['state']:g}°; its peak bar strain reaches {strain:.1e}, "
-            "the largest of the study (aluminium's elastic limit is about 3e-3)."
+            f"{where} (aluminium's elastic limit is about 3e-3)."
         )
     resch, wb = _rows("resch"), _rows("waterbomb")
     if resch and wb:

@@ -85,3 +85,37 @@ def test_ranking_states_every_roof_once(study) -> None:
         ok, why = study.stable(r, None)
         assert ok == (r["buckling_factor"] > 1.0)
         assert ok or "linear buckling factor" in why
+
+
+def test_cell_membrane_error_is_the_worst_face_of_the_roof(study) -> None:
+    """``roofs.cell_membrane_error`` against every face computed on its own (no shape
+    grouping): the worst homogeneous-mode error of panel_errors, whose reference is the
+    closed-form plane-stress energy. Square pleat panels are near exact (the lattice is exact
+    at nu = 1/3; the sheet has 0.33), the Yoshimura's right-isosceles triangles are not."""
+    import numpy as np
+
+    from barhinge.model.compare import panel_errors
+
+    roofs = study.roofs
+    for fam, state, low, high in (("pleats", 90.0, 0.0, 0.01), ("yoshimura", 20.0, 0.5, 0.9)):
+        cp, _, _ = roofs.folded(fam, state)
+        X = np.asarray(cp.vertices3d)
+        worst = 0.0
+        for f in cp.faces:
+            P = X[list(f)]
+            e1 = (P[1] - P[0]) / np.linalg.norm(P[1] - P[0])
+            n = np.cross(P[1] - P[0], P[2] - P[0])
+            e2 = np.cross(n / np.linalg.norm(n), e1)
+            Q = np.column_stack([(P - P[0]) @ e1, (P - P[0]) @ e2])
+            e = panel_errors(Q, roofs.material(), "N5B8", "fit", plate_refine=1)
+            worst = max(worst, *(abs(v) for k, v in e.items() if k != "warp"))
+        got = roofs.cell_membrane_error(cp)
+        assert got == pytest.approx(worst, rel=1e-6)
+        assert low <= got <= high
+
+
+def test_ranking_marks_roofs_whose_cells_miss_the_membrane(study) -> None:
+    rows = [dict(r, membrane_error=0.7) for r in study.RESULTS]
+    text = study.ranking(rows, {})
+    assert text.count("indicative: cells' membrane error 0.70") == len(rows)
+    assert "bar lattice's own limit" in study.membrane_finding(rows)
