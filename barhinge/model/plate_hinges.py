@@ -365,10 +365,12 @@ def coupled_bending(model: BarHingeModel) -> BarHingeModel:
     Couplings stay inside cells and never involve a crease hinge: a crease's angle holds its
     own rotation, which the plate energy must not see. Cells on a crease or a free edge keep
     the principal part of their matrix (positive semi-definite); their crease hinge gets the
-    cell's diagonal entry as its plate strip. Needs N5B8 quadrilateral or triangular faces on
-    a grid where the neighbour across a side is the cell's point reflection (the grids of
-    ``barhinge.pattern.subdivide.subdivided``); elsewhere a warning names the largest
-    mismatch of the hinge angles against that assumption.
+    cell's diagonal entry as its plate strip. Needs N5B8 quadrilateral or triangular faces.
+    A quadrilateral cell takes its neighbours' centre nodes where they are (any grid of
+    quadrilaterals, e.g. a bilinear grid of a trapezoid); a triangular cell assumes that the
+    neighbour across a side is its point reflection (the barycentric grids of
+    ``barhinge.pattern.subdivide.subdivided``). Where the model's hinge angles disagree with
+    the cells' rows, a warning names the largest mismatch.
     """
     from barhinge.kernels.geometry import hinge_angle_derivatives
 
