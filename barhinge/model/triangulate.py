@@ -8,8 +8,8 @@
   diagonal's two half-bars are collinear: under any uniform in-plane strain the centre node is
   then in equilibrium when they have equal stiffness (``calibrate.bar_areas`` ties them), and
   the panel stores the membrane energy its bars were fitted to. At the corners' mean (the
-  same point for a parallelogram) the centre node of a trapezoid relaxes under uniform strain:
-  a refined arched-Miura panel kept 16-54 % of its membrane stiffness across one direction;
+  same point for a parallelogram) the centre node of a trapezoid moves under a uniform strain
+  and the panel's membrane is too soft (tests/model/test_model_quad_centres.py);
 * polygons with more than four corners by a centre node (mean of the corners) joined to every
   corner, in both schemes.
 

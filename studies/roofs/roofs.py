@@ -411,16 +411,15 @@ def cell_membrane_error(cp) -> float:
     material; :func:`barhinge.model.compare.panel_errors`). A panel cut into cells keeps its
     shape's error (Table 4 of docs/calibration.md), so refinement converges to a sheet whose
     membrane is off by about this much in its worst direction."""
+    from barhinge.model.calibrate import face_frames
     from barhinge.model.compare import panel_errors
 
     X = np.asarray(cp.vertices3d, float)
     shapes: dict[tuple, np.ndarray] = {}
-    for f in cp.faces:
-        P = X[list(f)]
-        e1 = (P[1] - P[0]) / np.linalg.norm(P[1] - P[0])
-        n = np.cross(P, np.roll(P, -1, axis=0)).sum(axis=0)
-        e2 = np.cross(n / np.linalg.norm(n), e1)
-        Q = np.column_stack([(P - P[0]) @ e1, (P - P[0]) @ e2])
+    for fi, f in enumerate(cp.faces):
+        e1, e2, _ = face_frames(X, cp.faces, np.array([fi]))
+        R = X[list(f)] - X[f[0]]
+        Q = np.column_stack([R @ e1[0], R @ e2[0]])
         shapes.setdefault(tuple(np.round(Q / np.abs(Q).max(), 6).ravel()), Q)
     worst = 0.0
     for Q in shapes.values():
