@@ -63,6 +63,11 @@ SHELL_GRADING = 2.0
 #: the main rule is refined past its fixed levels until its stiffness changes by less than
 #: ``roofs.REFINE_TOL`` or the next level would exceed this many DOFs
 DOF_BUDGET = 7_000 if QUICK else roofs.REFINE_DOF_BUDGET
+#: the graded shell reference is refined past ``SHELL_LEVELS`` (r + 1) until its Richardson
+#: estimate holds (observed order at least ``accuracy.MIN_ORDER``, correction below
+#: ``roofs.REFINE_TOL``) or the next level would exceed this many DOFs (about 12 GB of memory
+#: at 3.6 million)
+SHELL_DOF_BUDGET = 20_000 if QUICK else 4_000_000
 
 if QUICK:
     ROOFS = [("pleats", 90.0)]
@@ -325,6 +330,24 @@ def extended(cp, sv, se, rows: list[dict]) -> list[dict]:
     return rows
 
 
+def shell_settled(rows: list[dict]) -> bool:
+    """Whether the shell levels ``rows`` give a reference: a Richardson estimate (order at
+    least ``MIN_ORDER``) whose correction is below ``roofs.REFINE_TOL``."""
+    ref, _, unc = extrapolate([s_["stiffness"] for s_ in rows])
+    return len(rows) >= 3 and math.isfinite(unc) and unc <= roofs.REFINE_TOL * abs(ref)
+
+
+def shell_extended(cp, sv, se, crease_k: float, rows: list[dict]) -> list[dict]:
+    """The graded shell levels ``rows`` refined further (r + 1) until :func:`shell_settled`
+    or the next level would exceed ``SHELL_DOF_BUDGET`` (each level has about four times the
+    DOFs of the one before)."""
+    rows = list(rows)
+    while not shell_settled(rows) and 4 * rows[-1]["n_dof"] <= SHELL_DOF_BUDGET:
+        rows.append(shell(cp, sv, se, rows[-1]["r"] + 1, crease_k, grading=SHELL_GRADING))
+        print(f"  shell r = {rows[-1]['r']}: {rows[-1]['stiffness'] / 1e3:.2f} kN/m", flush=True)
+    return rows
+
+
 def refined_until(rows: list[dict], tol: float = roofs.REFINE_TOL) -> dict:
     """The first level at which the stiffness has settled (:func:`roofs.settled`: changed by
     less than ``tol`` from the previous level, in the asymptotic range); the finest level
@@ -346,6 +369,7 @@ def run() -> list[dict]:
         n4b5 = bar_hinge(cp, sv, se, 1, "plate", scheme="N4B5")
         ck = bhr["plate"][0]["crease_k"]
         shr = [shell(cp, sv, se, r, ck, grading=SHELL_GRADING) for r in SHELL_LEVELS]
+        shr = shell_extended(cp, sv, se, ck, shr)
         shu = [shell(cp, sv, se, r, ck) for r in SHELL_LEVELS]
         raw = {"family": fam, "state": state, "bar_hinge": bhr, "n4b5": n4b5}
         out.append(derive({**raw, "shell": shr, "shell_uniform": shu}))
@@ -449,7 +473,10 @@ if CACHE and Path(CACHE).exists():
         cp, flat_xy, _ = roofs.folded(r["family"], r["state"])
         sv, se = support_sets(cp, flat_xy, roofs.FAMILIES[r["family"]]["axis"])
         r["bar_hinge"][MAIN_RULE] = extended(cp, sv, se, rows)
-        if len(r["bar_hinge"][MAIN_RULE]) > len(rows):
+        n_shell = len(r["shell"])  # and the shell reference, where it has not settled
+        ck = r["bar_hinge"]["plate"][0]["crease_k"]
+        r["shell"] = shell_extended(cp, sv, se, ck, r["shell"])
+        if len(r["bar_hinge"][MAIN_RULE]) > len(rows) or len(r["shell"]) > n_shell:
             Path(CACHE).write_text(json.dumps([RESULTS, PLATE]))
     RESULTS = [derive(r) for r in RESULTS]  # the levels are cached, the rest is re-derived
     if "split" not in PLATE:
@@ -773,7 +800,10 @@ def prose(results: list[dict], plate: dict) -> str:
             f"and its reference is settled to ± {100 * split_roof['shell_uncertainty']:.1f} % "
             f"(uniform: ± {100 * split_roof['uniform_uncertainty']:.1f} %). The bar-and-hinge "
             "sub-panels are uniform, so its refinement stays slow on these roofs.",
-            sides_finding(plate["sides"]),
+            sides_finding(
+                plate["sides"],
+                next((r for r in results if (r["family"], r["state"]) == SIDES_ROOF), None),
+            ),
         ]
     )
 
@@ -787,13 +817,27 @@ def _trend(k: list[float]) -> str:
     return "is not monotone"
 
 
-def sides_finding(sides: dict) -> str:
-    """Finding 7: the graded shell of ``SIDES_ROOF`` split into its parts."""
+def sides_finding(sides: dict, roof: dict | None = None) -> str:
+    """Finding 7: the graded shell of ``SIDES_ROOF`` split into its parts (``roof``: its
+    results, whose shell may be refined past the split's levels)."""
     label = f"{SIDES_ROOF[0]} {SIDES_ROOF[1]:g}"
     lv = sides["sheet"]["levels"]
     mem, pla = sides["stiff membranes"]["stiffness"], sides["stiff plates"]["stiffness"]
+    later = ""
+    settled = roof is not None and np.isfinite(roof["shell_uncertainty"])
+    if roof is not None and settled and len(roof["shell"]) > len(lv):
+        extra = roof["shell"][len(lv) :]
+        ks = ", ".join(f"{s_['stiffness'] / 1e3:.1f}" for s_ in extra)
+        later = (
+            f" Refined further (r = {', '.join(str(s_['r']) for s_ in extra)}: {ks} kN/m, up to "
+            f"{extra[-1]['n_dof']:,} DOFs) its changes shrink at order "
+            f"{_num(roof['shell_rate'])}, and the reference is "
+            f"{roof['shell_reference'] / 1e3:.1f} kN/m ± "
+            f"{100 * roof['shell_uncertainty']:.1f} %."
+        )
+    head = "settles late" if settled else "is not settled"
     return (
-        f"7. **Why the {label} shell is not settled.** Its graded shell refined "
+        f"7. **Why the {label} shell {head}.** Its graded shell refined "
         f"(r = {', '.join(str(r) for r in lv)}): "
         + "; ".join(
             f"{name} {', '.join(f'{k / 1e3:.1f}' for k in d['stiffness'])} kN/m"
@@ -804,8 +848,8 @@ def sides_finding(sides: dict) -> str:
         "the flat plate above). With stiff plates, where the membranes carry it, it "
         f"{_trend(pla)}: the constant-strain membranes are conforming and converge from "
         f"above. The sheet itself {_trend(sides['sheet']['stiffness'])}: its two errors "
-        "have opposite signs and neither dominates yet at the finest level, so no single "
-        "order extrapolates it."
+        f"have opposite signs and neither dominates yet at r = {lv[-1]}, so no single "
+        "order extrapolates these levels." + later
     )
 
 
