@@ -433,6 +433,75 @@ def cell_membrane_error(cp, bar_calibration: str = "fit") -> float:
     return worst
 
 
+#: the shell reference's facet meshes are graded towards the facets' corners (elements next
+#: to a pattern vertex h^2 long), where a folded sheet's stresses are singular
+SHELL_GRADING = 2.0
+
+
+def crease_stiffness_per_length(model) -> float:
+    """Fold-hinge stiffness per unit crease length of the M/V creases (uniform)."""
+    asg = np.asarray(model.pattern.assignment)
+    X = np.asarray(model.X0)
+    h = model.hinges
+    f = (model.hinge_kind == "fold") & (model.hinge_edge >= 0)
+    f &= np.isin(asg[np.maximum(model.hinge_edge, 0)], ["M", "V"])
+    ell = np.linalg.norm(X[h[f, 1]] - X[h[f, 0]], axis=1)
+    k = model.hinge_k[f] / ell
+    if not np.allclose(k, k[0], rtol=1e-9):
+        raise ValueError("crease stiffness per length is not uniform")
+    return float(k[0])
+
+
+def shell_level(
+    cp, sv, se, r: int, crease_k: float, sheet: Any = None, grading: float = 1.0
+) -> dict[str, Any]:
+    """Stiffness ``Q_t^2 / (f . u)`` of the facet shell roof (:mod:`barhinge.model.shell`)
+    at refinement ``r`` under the uniform load, creases of ``crease_k`` (moment per radian per
+    length), ``sheet`` the study's unless given, facet meshes of ``grading`` (1: uniform)."""
+    import time
+
+    from barhinge.model.shell import shell_model
+
+    t0 = time.perf_counter()
+    mat = material() if sheet is None else sheet
+    sh = shell_model(cp, mat, r, crease_stiffness=crease_k, grading=grading)
+    f = sh.surface_load((0.0, 0.0, -Q), per="plan")
+    u = sh.solve(f, np.union1d(sh.nodes_on_edges(se), sv))
+    Qt = float(-sh.translations(f)[:, 2].sum())
+    return {
+        "r": r,
+        "stiffness": Qt**2 / float(f @ u),
+        "n_dof": sh.n_dof,
+        "time_s": time.perf_counter() - t0,
+        "load": Qt,
+    }
+
+
+def shell_settled(rows: list[dict]) -> bool:
+    """Whether the shell levels ``rows`` give a reference: a Richardson estimate
+    (:func:`barhinge.analysis.accuracy.richardson`, order at least its ``MIN_ORDER``) whose
+    correction is below ``REFINE_TOL``."""
+    from barhinge.analysis.accuracy import richardson
+
+    if len(rows) < 3:
+        return False
+    ref, _, unc = richardson([s_["stiffness"] for s_ in rows])
+    return math.isfinite(unc) and unc <= REFINE_TOL * abs(ref)
+
+
+def shell_extended(
+    cp, sv, se, crease_k: float, rows: list[dict], budget: int, grading: float = SHELL_GRADING
+) -> list[dict]:
+    """The shell levels ``rows`` refined further (r + 1) until :func:`shell_settled` or the
+    next level would exceed ``budget`` DOFs (each level has about four times the DOFs of the
+    one before)."""
+    rows = list(rows)
+    while not shell_settled(rows) and 4 * rows[-1]["n_dof"] <= budget:
+        rows.append(shell_level(cp, sv, se, rows[-1]["r"] + 1, crease_k, grading=grading))
+        print(f"  shell r = {rows[-1]['r']}: {rows[-1]['stiffness'] / 1e3:.2f} kN/m", flush=True)
+    return rows
+
+
 def subdivided_roof(
     cp, sv: np.ndarray, se: np.ndarray, m: int, rule: str = "coupled", scheme: str = "N5B8",
     sheet: Any = None,

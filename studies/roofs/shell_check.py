@@ -55,10 +55,9 @@ VARIANTS = roofs.BENDING_RULES
 CONSISTENT = ("consistent", "coupled")
 #: the rule each roof is refined with for its limit (couplings: the sheet's Poisson ratio)
 MAIN_RULE = "coupled"
-#: the roofs' shell reference: facet meshes graded towards the corners (elements next to a
-#: pattern vertex h^2 long), where a folded sheet's stresses are singular; uniform meshes
-#: are refined beside it for comparison
-SHELL_GRADING = 2.0
+#: the roofs' shell reference: facet meshes graded towards the corners (``roofs.SHELL_GRADING``);
+#: uniform meshes are refined beside it for comparison
+SHELL_GRADING = roofs.SHELL_GRADING
 
 #: the main rule is refined past its fixed levels until its stiffness changes by less than
 #: ``roofs.REFINE_TOL`` or the next level would exceed this many DOFs
@@ -98,20 +97,6 @@ def support_sets(cp, flat_xy: np.ndarray, axis: int) -> tuple[np.ndarray, np.nda
     return roofs.support_lines(cp, flat_xy, axis)
 
 
-def crease_stiffness_per_length(model) -> float:
-    """Fold-hinge stiffness per unit crease length of the M/V creases (uniform)."""
-    asg = np.asarray(model.pattern.assignment)
-    X = np.asarray(model.X0)
-    h = model.hinges
-    f = (model.hinge_kind == "fold") & (model.hinge_edge >= 0)
-    f &= np.isin(asg[np.maximum(model.hinge_edge, 0)], ["M", "V"])
-    ell = np.linalg.norm(X[h[f, 1]] - X[h[f, 0]], axis=1)
-    k = model.hinge_k[f] / ell
-    if not np.allclose(k, k[0], rtol=1e-9):
-        raise ValueError("crease stiffness per length is not uniform")
-    return float(k[0])
-
-
 def bar_hinge(cp, sv, se, m: int, variant: str = "plate", scheme: str = "N5B8") -> dict:
     """Stiffness of the bar-and-hinge roof with m x m sub-panels (bending rule ``variant``,
     :func:`roofs.subdivided_roof`)."""
@@ -122,7 +107,7 @@ def bar_hinge(cp, sv, se, m: int, variant: str = "plate", scheme: str = "N5B8") 
     model, S, residual = roofs.subdivided_roof(cp, sv, se, m, variant, scheme)
     # the creases' own springs (the plate-consistent rules put them in series with the strip)
     base = bh.BarHingeModel.from_pattern(cp, scheme, roofs.material())
-    crease_k = crease_stiffness_per_length(base)
+    crease_k = roofs.crease_stiffness_per_length(base)
     F = roofs.plan_load(model, roofs.Q)
     U, _ = linear_response(model, F, S)
     Qt = float(-F[:, 2].sum())
@@ -143,23 +128,8 @@ def membrane(variant: str) -> str:
 
 
 def shell(cp, sv, se, r: int, crease_k: float, material=None, grading: float = 1.0) -> dict:
-    """Stiffness of the facet shell roof at refinement r (``material``: the study's sheet
-    unless given; ``grading``: of the facet meshes, 1 uniform)."""
-    from barhinge.model.shell import shell_model
-
-    t0 = time.perf_counter()
-    mat = roofs.material() if material is None else material
-    sh = shell_model(cp, mat, r, crease_stiffness=crease_k, grading=grading)
-    f = sh.surface_load((0.0, 0.0, -roofs.Q), per="plan")
-    u = sh.solve(f, np.union1d(sh.nodes_on_edges(se), sv))
-    Qt = float(-sh.translations(f)[:, 2].sum())
-    return {
-        "r": r,
-        "stiffness": Qt**2 / float(f @ u),
-        "n_dof": sh.n_dof,
-        "time_s": time.perf_counter() - t0,
-        "load": Qt,
-    }
+    """Stiffness of the facet shell roof at refinement r (:func:`roofs.shell_level`)."""
+    return roofs.shell_level(cp, sv, se, r, crease_k, material, grading)
 
 
 def navier_plate_stiffness(a: float, D: float, q: float, terms: int = 199) -> float:
@@ -336,22 +306,10 @@ def extended(cp, sv, se, rows: list[dict]) -> list[dict]:
     return rows
 
 
-def shell_settled(rows: list[dict]) -> bool:
-    """Whether the shell levels ``rows`` give a reference: a Richardson estimate (order at
-    least ``MIN_ORDER``) whose correction is below ``roofs.REFINE_TOL``."""
-    ref, _, unc = extrapolate([s_["stiffness"] for s_ in rows])
-    return len(rows) >= 3 and math.isfinite(unc) and unc <= roofs.REFINE_TOL * abs(ref)
-
-
 def shell_extended(cp, sv, se, crease_k: float, rows: list[dict]) -> list[dict]:
-    """The graded shell levels ``rows`` refined further (r + 1) until :func:`shell_settled`
-    or the next level would exceed ``SHELL_DOF_BUDGET`` (each level has about four times the
-    DOFs of the one before)."""
-    rows = list(rows)
-    while not shell_settled(rows) and 4 * rows[-1]["n_dof"] <= SHELL_DOF_BUDGET:
-        rows.append(shell(cp, sv, se, rows[-1]["r"] + 1, crease_k, grading=SHELL_GRADING))
-        print(f"  shell r = {rows[-1]['r']}: {rows[-1]['stiffness'] / 1e3:.2f} kN/m", flush=True)
-    return rows
+    """The graded shell levels ``rows`` refined further until they settle, within
+    ``SHELL_DOF_BUDGET`` (:func:`roofs.shell_extended`)."""
+    return roofs.shell_extended(cp, sv, se, crease_k, rows, SHELL_DOF_BUDGET, SHELL_GRADING)
 
 
 def refined_until(rows: list[dict], tol: float = roofs.REFINE_TOL) -> dict:
@@ -465,7 +423,7 @@ def membrane_bending_split(
     import barhinge as bh
 
     model = bh.BarHingeModel.from_pattern(cp, "N5B8", roofs.material())
-    ck = crease_stiffness_per_length(model)
+    ck = roofs.crease_stiffness_per_length(model)
     out = {}
     for name, mat in split_materials().items():
         k = [shell(cp, sv, se, r, ck, mat, grading)["stiffness"] for r in levels]

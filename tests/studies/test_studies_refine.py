@@ -142,3 +142,26 @@ def test_levels_of_another_membrane_are_recomputed(study) -> None:
     rows = study.refine(fam, state, stale)
     assert {x["membrane"] for x in rows} == {"cst"}
     assert [x["stiffness"] for x in rows] == [x["stiffness"] for x in study.RESULTS[0]["rows"]]
+
+
+def test_every_roof_has_its_shell_gap(study) -> None:
+    """The shell reference of each roof is the Richardson estimate of its graded shell levels
+    (``roofs.shell_level``, at least ``SHELL_LEVELS``), and the gap is the refined limit over
+    it, both per width; the table and the findings report them."""
+    import math
+
+    from barhinge.analysis.accuracy import richardson
+
+    for r in study.RESULTS:
+        rs = [s["r"] for s in r["shell"]]
+        assert rs[: len(study.SHELL_LEVELS)] == list(study.SHELL_LEVELS)
+        ref, _, corr = richardson([s["stiffness"] for s in r["shell"]])
+        width = r["rows"][-1]["plan_area"] / study.roofs.SPAN
+        assert r["shell_reference_per_width"] == pytest.approx(ref / width, rel=1e-12)
+        limit = r["limit_per_width"] * width
+        assert r["shell_gap"] == pytest.approx(limit / ref - 1.0, rel=1e-9)
+        if math.isfinite(corr):
+            assert r["shell_uncertainty"] == pytest.approx(abs(corr / ref), rel=1e-9)
+    text = study.table(study.RESULTS, {})
+    assert "limit / shell − 1" in text
+    assert "6. **Against the shell.**" in study.shell_finding(study.RESULTS)
