@@ -469,15 +469,16 @@ def shell_finding(results: list[dict]) -> str:
         f"{len(settled)} of {len(have)} references settle to within {100 * SHELL_TOL:g} %; of"
         f" those roofs, {len(within)} have a refined limit within 5 % of the shell"
         + (
-            " ("
+            "; "
             + ", ".join(f"{lab(r)} {_pct(r['shell_gap'])}" for r in off)
-            + " do not: "
+            + " do not"
             + (
-                "their refinement stopped at the DOF budget, finding 1"
+                " (all of them stopped at the DOF budget, finding 1)"
                 if all(not r["refined"] for r in off)
-                else "not all of them stopped at the DOF budget"
+                else " ("
+                + ", ".join(lab(r) for r in off if r["refined"])
+                + " refined to 2 %, the others stopped at the DOF budget, finding 1)"
             )
-            + ")"
             if off
             else ""
         )

@@ -439,7 +439,8 @@ SHELL_GRADING = 2.0
 
 
 def crease_stiffness_per_length(model) -> float:
-    """Fold-hinge stiffness per unit crease length of the M/V creases (uniform)."""
+    """Fold-hinge stiffness per unit crease length of the M/V creases (uniform; 0 for a
+    pattern without any, such as the flat sheet)."""
     asg = np.asarray(model.pattern.assignment)
     X = np.asarray(model.X0)
     h = model.hinges
@@ -447,6 +448,8 @@ def crease_stiffness_per_length(model) -> float:
     f &= np.isin(asg[np.maximum(model.hinge_edge, 0)], ["M", "V"])
     ell = np.linalg.norm(X[h[f, 1]] - X[h[f, 0]], axis=1)
     k = model.hinge_k[f] / ell
+    if not len(k):
+        return 0.0
     if not np.allclose(k, k[0], rtol=1e-9):
         raise ValueError("crease stiffness per length is not uniform")
     return float(k[0])
