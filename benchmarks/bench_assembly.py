@@ -4,6 +4,7 @@ Prints a table of median wall and CPU times per call:
 
     /work/venv/bin/python benchmarks/bench_assembly.py            # 100 x 100 cells, N5B8
     /work/venv/bin/python benchmarks/bench_assembly.py --n 50 --scheme N4B5 --repeat 7
+    /work/venv/bin/python benchmarks/bench_assembly.py --membrane cst   # coupled triangles
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import time
 import numpy as np
 
 import barhinge as bh
-from barhinge.model.model import BarHingeModel
+from barhinge.model.model import MEMBRANES, BarHingeModel
 
 
 def timed(fn, repeat: int) -> tuple[float, float]:
@@ -34,13 +35,14 @@ def main() -> None:
     ap.add_argument("--scheme", default="N5B8", choices=["N4B5", "N5B8"])
     ap.add_argument("--fold", type=float, default=30.0, help="Miura facet angle theta, deg")
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--membrane", default="fit", choices=MEMBRANES, help="bar_calibration")
     args = ap.parse_args()
 
     t0 = time.perf_counter()
     cp = bh.families.miura(args.n, args.n, fold=args.fold)
     t_pattern = time.perf_counter() - t0
     t0 = time.perf_counter()
-    model = BarHingeModel.from_pattern(cp, scheme=args.scheme)
+    model = BarHingeModel.from_pattern(cp, scheme=args.scheme, bar_calibration=args.membrane)
     t_model = time.perf_counter() - t0
     rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB on Linux
     t0, c0 = time.perf_counter(), time.process_time()
@@ -55,7 +57,7 @@ def main() -> None:
         ("force + tangent", timed(lambda: model.evaluate(X, tangent=True), args.repeat)),
     ]
     print(
-        f"Miura {args.n}x{args.n} cells, {args.scheme}: {model.n_nodes} nodes, "
+        f"Miura {args.n}x{args.n} cells, {args.scheme}, {args.membrane}: {model.n_nodes} nodes, "
         f"{model.n_dof} dof, {model.n_bars} bars, {model.n_hinges} hinges, "
         f"tangent nnz {asm.nnz}"
     )

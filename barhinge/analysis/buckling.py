@@ -33,7 +33,6 @@ from barhinge.kernels.geometry import (
     hinge_angle_gradient,
     hinge_energy_hessian_packed,
 )
-from barhinge.kernels.laws import bar_linear
 from barhinge.linalg.backends import SingularMatrixError, get_backend
 from barhinge.linalg.threads import threads_for_sparse
 
@@ -99,7 +98,7 @@ def stiffness_parts(model: Any, X: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_ma
     ``model.tangent(X)``."""
     X = np.asarray(X, float).reshape(-1, 3)
     eps, d, B = bar_strain_derivatives(X, model.bars, model.bar_L0, model.strain)
-    S, dS, _ = bar_linear(eps, model.bar_EA, model.bar_L0)
+    S, dS, _ = model.bar_law(eps)
     rho = model.hinge_angles(X)
     M, Kt, _ = model._hinge_law(rho)
     asm = model.assembler
@@ -107,7 +106,8 @@ def stiffness_parts(model: Any, X: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_ma
     nb = len(model.bars)
     Km_b = _bar_blocks(dS, np.zeros(nb), d, B)
     Kg = geometric_stiffness(model, X, S, M)
-    if len(getattr(model, "hinge_pairs", ())):  # couplings: their cross terms are material
+    if len(getattr(model, "hinge_pairs", ())) or len(getattr(model, "bar_pairs", ())):
+        # couplings: their cross terms are material
         return (model.evaluate(X).K - Kg).tocsr(), Kg
     Km = asm.matrix_packed([Km_b[:, iu, ju].T, _hinge_packed(model, X, np.zeros_like(M), Kt)])
     return Km, Kg
@@ -173,8 +173,11 @@ def linear_buckling(
         )
     U = du.reshape(n, 3)
     eps, d, _ = bar_strain_derivatives(X, model.bars, model.bar_L0, model.strain)
-    _, dSde, _ = bar_linear(eps, model.bar_EA, model.bar_L0)
-    dS = dSde * np.einsum("bi,bi->b", d, U[model.bars[:, 1]] - U[model.bars[:, 0]])
+    _, dSde, _ = model.bar_law(eps)
+    deps = np.einsum("bi,bi->b", d, U[model.bars[:, 1]] - U[model.bars[:, 0]])
+    dS = dSde * deps
+    if len(getattr(model, "bar_pairs", ())):  # the couplings' forces change too
+        dS = dS + model._bar_C @ deps
     rho, g = _rho_grad(model, X)
     _, Kt, _ = model._hinge_law(rho)
     drho = np.einsum("hk,hk->h", g, du[_hinge_dofs(model)])

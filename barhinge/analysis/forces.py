@@ -111,10 +111,12 @@ class StateResults:
 
 def bar_axial_forces(model: Any, X: np.ndarray) -> np.ndarray:
     """(n_bars,) axial force of every bar at ``X`` (n_nodes, 3), tension > 0: the force the
-    bar exerts on its end nodes (``EA eps L / L0`` for Green strain, ``EA eps`` for
-    engineering strain)."""
+    bar exerts on its end nodes: ``S |d eps/dx|`` with ``S = dW/deps`` (``EA L0 eps`` for a
+    bar, so ``EA eps L / L0`` for Green strain and ``EA eps`` for engineering strain; with
+    the CST membrane ``S`` includes the couplings ``(C eps)_b``)."""
     eps, d, _ = bar_strain_derivatives(X, model.bars, model.bar_L0, model.strain)
-    return model.bar_EA * model.bar_L0 * eps * np.linalg.norm(d, axis=1)
+    S, _, _ = model.bar_law(eps)
+    return S * np.linalg.norm(d, axis=1)
 
 
 _FACE_BARS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()

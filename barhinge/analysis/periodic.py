@@ -301,6 +301,12 @@ def periodic_cell(
             "periodic cell needs a sheet of at least 2 x 2 periods (a single cell has no fold "
             "hinges on its boundary creases)"
         )
+    if len(getattr(model, "bar_pairs", ())):
+        raise ConfigError(
+            "the periodic cell weighs bars one by one; the CST membrane couples the sides of "
+            "its triangles: build the model with a bar calibration ('fit', 'filipov' or "
+            "'dilation')"
+        )
     wb = _element_weights(model.bars, model.bar_EA, cls, k, lat, [[0, 1]], "bar")
     wh = _element_weights(model.hinges, model.hinge_k, cls, k, lat, [[0, 1], [2, 3]], "hinge")
     cell = model.with_(bar_EA=model.bar_EA * wb, hinge_k=model.hinge_k * wh)

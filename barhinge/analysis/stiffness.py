@@ -266,7 +266,11 @@ def stiffness_modes(
     e = Xs[B[:, 1]] - Xs[B[:, 0]]
     e /= np.linalg.norm(e, axis=1, keepdims=True)
     rate = np.einsum("bx,mbx->mb", e, shapes[:, B[:, 1]] - shapes[:, B[:, 0]])
-    bar_energy = (np.asarray(model.bar_EA) / np.asarray(model.bar_L0) * rate**2).sum(1)
+    L0 = np.asarray(model.bar_L0)
+    bar_energy = (np.asarray(model.bar_EA) / L0 * rate**2).sum(1)
+    if len(getattr(model, "bar_pairs", ())):  # the CST membrane's couplings: eps^T C_off eps
+        strain_rate = rate / L0
+        bar_energy += np.einsum("mb,mb->m", strain_rate, (model._bar_C @ strain_rate.T).T)
     total = np.einsum("mi,im->m", shapes.reshape(k, -1), K @ shapes.reshape(k, -1).T)
     zero = np.abs(w) <= 1e-10 * scale
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -187,6 +187,22 @@ def assemble_reference(model, X: np.ndarray) -> tuple[float, np.ndarray, np.ndar
         E += W
         f[dofs] += S * g
         K[np.ix_(dofs, dofs)] += dS * np.outer(g, g) + S * H
+    # the CST membrane's couplings c eps_i eps_j (barhinge.model.membrane), pair by pair
+    for (bi, bj), c in zip(model.bar_pairs, model.bar_pair_c, strict=True):
+        ends = [model.bars[bi], model.bars[bj]]
+        parts = [
+            bar_reference(X[a_], X[b_], model.bar_L0[b], model.strain)
+            for b, (a_, b_) in zip((bi, bj), ends, strict=True)
+        ]
+        dofs = [np.r_[3 * a_ : 3 * a_ + 3, 3 * b_ : 3 * b_ + 3] for a_, b_ in ends]
+        (ei, gi, Hi), (ej, gj, Hj) = parts
+        E += c * ei * ej
+        f[dofs[0]] += c * ej * gi
+        f[dofs[1]] += c * ei * gj
+        K[np.ix_(dofs[0], dofs[1])] += c * np.outer(gi, gj)
+        K[np.ix_(dofs[1], dofs[0])] += c * np.outer(gj, gi)
+        K[np.ix_(dofs[0], dofs[0])] += c * ej * Hi
+        K[np.ix_(dofs[1], dofs[1])] += c * ei * Hj
     lo0, hi0 = model.fold_limits
     for h, (i, j, k, l) in enumerate(model.hinges):
         # limits widened to the rest angle (see BarHingeModel.fold_limits_per_hinge)

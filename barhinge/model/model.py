@@ -1,7 +1,9 @@
 """BarHingeModel: the bar-and-hinge model of a crease pattern (Filipov et al. 2017;
 Liu & Paulino 2017).
 
-Energy ``E(X) = sum_bars W_b(eps_b) + sum_bend W_h(rho_h) + sum_fold W_f(rho_f)``; the
+Energy ``E(X) = sum_bars W_b(eps_b) + sum_bend W_h(rho_h) + sum_fold W_f(rho_f)``, or with
+the constant-strain-triangle membrane (``bar_calibration="cst"``, :mod:`barhinge.model.membrane`)
+the bars' part ``eps^T C eps / 2`` with the sides of each triangle coupled; the
 internal force is ``dE/dX`` and the tangent ``d^2E/dX^2`` (material + geometric parts), both
 exact. Node ordering: the pattern's vertices first (in order), then the centre nodes of N5B8
 quads and polygons.
@@ -45,15 +47,19 @@ from barhinge.model.calibrate import (
 from barhinge.model.continuum import panel_corner_stiffness, plate_corner_stiffness
 from barhinge.model.hinge_pairs import pair_matrix, pair_nodes
 from barhinge.model.material import Material
+from barhinge.model.membrane import cst_bar_matrix
 from barhinge.model.topology import build_topology
 from barhinge.model.triangulate import triangulate
 from barhinge.pattern.crease import CreasePattern
 
 logger = logging.getLogger(__name__)
 
-__all__ = ["BarHingeModel", "Evaluation", "FOLD_LAWS", "plate_bend_scale"]
+__all__ = ["BarHingeModel", "Evaluation", "FOLD_LAWS", "MEMBRANES", "plate_bend_scale"]
 
 FOLD_LAWS = ("linear", "penetration")
+#: the panels' membrane: bars calibrated by one of ``BAR_CALIBRATIONS``, or ``"cst"``, the
+#: constant-strain triangle written in the bars' strains (exact for every triangle shape)
+MEMBRANES = (*BAR_CALIBRATIONS, "cst")
 
 # packed upper triangle of a bar's 6x6 [[k, -k], [-k, k]]: which of the 6 distinct entries
 # of the symmetric 3x3 k (_SYM3) each packed entry holds, with which sign; _BAR_FIRST[q] is
@@ -84,7 +90,7 @@ class Evaluation:
         Tangent stiffness ``d^2E/dX^2`` (None if ``tangent=False``).
     bar_strain : (n_bars,) float
     bar_force : (n_bars,) float
-        Axial force ``EA eps`` (tension > 0).
+        Axial force ``dW/deps / L0`` (``EA eps`` for a bar; tension > 0).
     hinge_angle : (n_hinges,) float
         Radians, FOLD convention.
     hinge_moment : (n_hinges,) float
@@ -135,6 +141,10 @@ class BarHingeModel:
     hinge_pairs : (n_pairs, 2) int, hinges whose angles are coupled (empty by default)
     pair_k : (n_pairs,) coupling ``c`` of the energy ``c (rho_i - rho_i0) (rho_j - rho_j0)``
         (moment per radian; :mod:`barhinge.model.hinge_pairs`)
+    bar_pairs : (n_bar_pairs, 2) int, bars whose strains are coupled (the sides of each
+        triangle with the CST membrane; empty by default)
+    bar_pair_c : (n_bar_pairs,) coupling ``c`` of the energy ``c eps_i eps_j`` (force x
+        length; :mod:`barhinge.model.membrane`)
     """
 
     pattern: CreasePattern
@@ -158,6 +168,10 @@ class BarHingeModel:
         default_factory=lambda: _ro(np.zeros((0, 2), np.int64))
     )
     pair_k: np.ndarray = dataclasses.field(default_factory=lambda: _ro(np.zeros(0)))
+    bar_pairs: np.ndarray = dataclasses.field(
+        default_factory=lambda: _ro(np.zeros((0, 2), np.int64))
+    )
+    bar_pair_c: np.ndarray = dataclasses.field(default_factory=lambda: _ro(np.zeros(0)))
 
     # ------------------------------------------------------------------ creation
     @classmethod
@@ -195,9 +209,11 @@ class BarHingeModel:
             limit studies).
         fold_law : ``"linear"`` or ``"penetration"`` (Liu & Paulino 2017) with
             ``fold_limits_deg``.
-        bar_calibration : ``"fit"`` (default, all membrane moduli), ``"filipov"`` (F17) or
-            ``"dilation"`` (``"fit"`` with the uniform-dilation energy exact); the errors of
-            each against a plane-stress membrane are tabulated in docs/calibration.md.
+        bar_calibration : ``"fit"`` (default, all membrane moduli), ``"filipov"`` (F17),
+            ``"dilation"`` (``"fit"`` with the uniform-dilation energy exact) or ``"cst"``
+            (the constant-strain triangle: bars of a triangle coupled, exact for every
+            triangle shape; :mod:`barhinge.model.membrane`); the errors of each against a
+            plane-stress membrane are tabulated in docs/calibration.md.
         bend_coefficient : ``C_B`` of the ``"filipov"`` rule (default 0.55); an error with
             the other rules.
         bend_calibration : ``"plate"`` (default: ``"kirchhoff"`` scaled per face shape so
@@ -213,7 +229,7 @@ class BarHingeModel:
         _check.choice(scheme, "scheme", SCHEMES)
         _check.choice(fold_law, "fold_law", FOLD_LAWS)
         _check.choice(strain, "strain", ("green", "engineering"))
-        _check.choice(bar_calibration, "bar_calibration", BAR_CALIBRATIONS)
+        _check.choice(bar_calibration, "bar_calibration", MEMBRANES)
         _check.choice(bend_calibration, "bend_calibration", ("filipov", "kirchhoff", "plate"))
         lim = _check.float_array(fold_limits_deg, "fold_limits_deg", (2,))
         lo, hi = float(lim[0]), float(lim[1])
@@ -250,7 +266,17 @@ class BarHingeModel:
         is_bend = ~is_fold
         axis_len = np.linalg.norm(X0[hinges[:, 1]] - X0[hinges[:, 0]], axis=1)
 
-        EA = mat.E * bar_areas(cp, tri, topo, mat, bar_calibration)
+        bar_pairs, bar_pair_c = np.zeros((0, 2), np.int64), np.zeros(0)
+        if bar_calibration == "cst":
+            if bar_EA is not None:
+                raise ConfigError(
+                    "bar_EA overrides the bars of a bar calibration; the 'cst' membrane has "
+                    "no bar areas to override"
+                )
+            diagonal, bar_pairs, bar_pair_c = cst_bar_matrix(X0, tri.triangles, bars, mat)
+            EA = diagonal / L0
+        else:
+            EA = mat.E * bar_areas(cp, tri, topo, mat, bar_calibration)
         # diagonal the bending hinge lies on: the axis itself (N4B5) or corner-centre-corner
         centred = (hinges[:, :2] >= cp.n_vertices).any(axis=1)
         DL = np.where(centred, 2.0 * axis_len, axis_len)
@@ -280,12 +306,14 @@ class BarHingeModel:
             if not stiffness_ratio > 0:
                 raise ConfigError(f"stiffness_ratio = {stiffness_ratio}; expected > 0")
             EA = EA * stiffness_ratio
+            bar_pair_c = bar_pair_c * stiffness_ratio
             k[is_bend] *= stiffness_ratio
         rest = hinge_angle(X0, hinges)
         for what, arr in (
             ("coordinates", X0),
             ("bar lengths", L0),
             ("bar stiffness", EA),
+            ("bar couplings", bar_pair_c),
             ("hinge stiffness", k),
             ("rest angles", rest),
         ):
@@ -311,6 +339,8 @@ class BarHingeModel:
             fold_law=fold_law,
             fold_limits=(np.radians(lo), np.radians(hi)),
             strain=strain,
+            bar_pairs=_ro(bar_pairs),
+            bar_pair_c=_ro(bar_pair_c),
             meta={
                 "bar_calibration": bar_calibration,
                 "bend_calibration": bend_calibration,
@@ -324,7 +354,7 @@ class BarHingeModel:
         for name, val in changes.items():
             if name not in kw:
                 raise ConfigError(f"BarHingeModel has no field {name!r}")
-            if name in ("hinge_pairs", "pair_k"):
+            if name in ("hinge_pairs", "pair_k", "bar_pairs", "bar_pair_c"):
                 kw[name] = _ro(np.array(val, dtype=kw[name].dtype))
                 continue
             if isinstance(kw[name], np.ndarray):
@@ -341,23 +371,34 @@ class BarHingeModel:
             )
         if len(pairs) and (pairs.min() < 0 or pairs.max() >= len(kw["hinges"])):
             raise ConfigError("hinge_pairs refers to a hinge the model does not have")
+        bpairs, bc = kw["bar_pairs"], kw["bar_pair_c"]
+        if bpairs.ndim != 2 or bpairs.shape[1] != 2 or bc.shape != (len(bpairs),):
+            raise ConfigError(
+                f"bar_pairs must have shape (n, 2) and bar_pair_c (n,), got {bpairs.shape} "
+                f"and {bc.shape}"
+            )
+        if len(bpairs) and (bpairs.min() < 0 or bpairs.max() >= len(kw["bars"])):
+            raise ConfigError("bar_pairs refers to a bar the model does not have")
         new = BarHingeModel(**kw)
         # same connectivity: share the (expensive) scatter maps
-        same = not {"bars", "hinges", "hinge_pairs"} & set(changes)
+        same = not {"bars", "hinges", "hinge_pairs", "bar_pairs"} & set(changes)
         if "assembler" in self.__dict__ and same:
             if len(new.X0) == len(self.X0):
                 new.__dict__["assembler"] = self.__dict__["assembler"]
         return new
 
     def stiffened(self, ratio: float) -> BarHingeModel:
-        """A new model with bar EA and bending stiffness multiplied by ``ratio``."""
+        """A new model with the membrane (bar EA and couplings) and bending stiffness
+        multiplied by ``ratio``."""
         if not ratio > 0:
             raise ConfigError(f"stiffness ratio = {ratio}; expected > 0")
         k = np.array(self.hinge_k)
         k[self.hinge_kind == "bend"] *= ratio
         both_bend = (self.hinge_kind[self.hinge_pairs] == "bend").all(axis=1)
         pk = np.where(both_bend, self.pair_k * ratio, self.pair_k)
-        return self.with_(bar_EA=self.bar_EA * ratio, hinge_k=k, pair_k=pk)
+        return self.with_(
+            bar_EA=self.bar_EA * ratio, bar_pair_c=self.bar_pair_c * ratio, hinge_k=k, pair_k=pk
+        )
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -425,6 +466,37 @@ class BarHingeModel:
         )
         asm.add_entries(K, G.T @ (self._pair_C @ G))
 
+    @cached_property
+    def _bar_C(self) -> sp.csr_matrix:
+        """(n_bars, n_bars) symmetric off-diagonal part of the membrane matrix ``C``."""
+        nb = self.n_bars
+        i, j = np.asarray(self.bar_pairs, np.int64).T
+        c = np.asarray(self.bar_pair_c, float)
+        return sp.csr_matrix((np.r_[c, c], (np.r_[i, j], np.r_[j, i])), shape=(nb, nb))
+
+    def bar_law(self, eps: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(dW/deps, d^2W/deps_b^2, W)`` per bar at the strains ``eps`` (n_bars,): the bars'
+        own ``EA L0`` plus, with bar couplings, ``(C eps)_b`` in the first and half of each
+        coupling's energy in the last (the cross second derivatives are :attr:`_bar_C`)."""
+        S, dS, W = bar_linear(eps, self.bar_EA, self.bar_L0)
+        if len(self.bar_pairs):
+            Ce = self._bar_C @ eps
+            S = S + Ce
+            W = W + 0.5 * eps * Ce
+        return S, dS, W
+
+    def _add_bar_pair_tangent(self, K: sp.csr_matrix, d: np.ndarray) -> None:
+        """Add the bar couplings' tangent ``G^T C_off G`` into ``K`` (in place): ``G`` (n_bars,
+        n_dof) the bar-strain gradients (``-d`` at the first node, ``d`` at the second); one
+        sparse product per evaluation, as for the hinge couplings."""
+        nb = self.n_bars
+        dofs = self.assembler.dofs[0]  # the bars' (n_bars, 6) dofs, the first group
+        vals = np.concatenate([-d, d], axis=1)
+        G = sp.csr_matrix(
+            (vals.ravel(), dofs.ravel(), np.arange(0, 6 * nb + 1, 6)), shape=(nb, self.n_dof)
+        )
+        self.assembler.add_entries(K, G.T @ (self._bar_C @ G))
+
     def _pair_moment(self, rho: np.ndarray) -> np.ndarray | None:
         """(n_hinges,) moments ``C (rho - rho0)`` of the hinge couplings (None without)."""
         if not len(self.hinge_pairs):
@@ -489,7 +561,7 @@ class BarHingeModel:
         X = self._check_X(X)
         bars, hinges = self.bars, self.hinges
         eps, d, B = bar_strain_derivatives(X, bars, self.bar_L0, self.strain)
-        S, dS, Wb = bar_linear(eps, self.bar_EA, self.bar_L0)
+        S, dS, Wb = self.bar_law(eps)
         fb = (S[:, None] * d).T  # (3, nb)
         fe_bar = np.concatenate([-fb, fb], axis=0)
         asm = self.assembler
@@ -519,6 +591,8 @@ class BarHingeModel:
             K = asm.matrix_packed(flat)
             if len(self.hinge_pairs):
                 self._add_pair_tangent(K, g)
+            if len(self.bar_pairs):
+                self._add_bar_pair_tangent(K, d)
         f = self._is_fold
         return Evaluation(
             energy_bars=float(Wb.sum()),
@@ -527,7 +601,7 @@ class BarHingeModel:
             force=force,
             K=K,
             bar_strain=eps,
-            bar_force=self.bar_EA * eps,
+            bar_force=S / self.bar_L0,
             hinge_angle=rho,
             hinge_moment=M,
         )
@@ -542,7 +616,7 @@ class BarHingeModel:
         with the model's own laws (per-hinge penetration limits included)."""
         X = self._check_X(X)
         eps = bar_strain(X, self.bars, self.bar_L0, self.strain)
-        _, _, Wb = bar_linear(eps, self.bar_EA, self.bar_L0)
+        _, _, Wb = self.bar_law(eps)
         _, _, Wh = self._hinge_law(hinge_angle(X, self.hinges))
         return Wb, Wh
 

@@ -60,10 +60,19 @@ START, END = "<!-- roofs-refined:start -->", "<!-- roofs-refined:end -->"
 TOL = roofs.REFINE_TOL
 #: the bending rule of the refinement
 RULE = "coupled"
+#: its membrane (``bar_calibration``): cached levels of another membrane are recomputed
+MEMBRANE = roofs.BENDING_RULES[RULE].get("bar_calibration", "fit")
 #: no level above this many DOFs is run
 DOF_BUDGET = 16_000 if QUICK else roofs.REFINE_DOF_BUDGET
 #: sub-panels per panel side, tried in order
 LEVELS = (1, 2, 4, 8, 16, 32, 64, 128)
+#: the shell reference of every roof (:func:`roofs.shell_level`, facet meshes graded towards
+#: the corners): these levels, then further until its Richardson estimate settles or the next
+#: level would exceed ``SHELL_DOF_BUDGET`` DOFs
+SHELL_LEVELS = (2, 3, 4) if QUICK else (1, 2, 3, 4, 5)
+SHELL_DOF_BUDGET = 60_000 if QUICK else 4_000_000
+#: a shell reference counts when it is settled to within this (relative uncertainty)
+SHELL_TOL = 0.05
 
 if QUICK:
     ROOFS: list[tuple[str, float]] = [("pleats", 90.0), ("yoshimura", 20.0)]
@@ -98,6 +107,7 @@ def level(cp, sv: np.ndarray, se: np.ndarray, m: int) -> dict[str, Any]:
         lam, why = float("nan"), str(exc).splitlines()[0]
     return {
         "m": m,
+        "membrane": MEMBRANE,
         "n_dof": 3 * model.n_nodes,
         "stiffness": Qt**2 / float(np.sum(Fq * U)),
         "plan_area": Qt / roofs.Q,
@@ -120,10 +130,11 @@ def change(rows: list[dict]) -> float:
 def refine(fam: str, state: float, done: list[dict], save=lambda rows: None) -> list[dict]:
     """The levels of one roof: ``done`` (cached) extended until the stiffness changes by less
     than ``TOL`` or the next level would exceed ``DOF_BUDGET``; ``save`` is called after every
-    new level."""
+    new level. Cached levels of another membrane than ``MEMBRANE`` are not used."""
     cp, flat_xy, _ = roofs.folded(fam, state)
     sv, se = roofs.support_lines(cp, flat_xy, roofs.FAMILIES[fam]["axis"])
-    rows = list(done)
+    rows = [r for r in done if r.get("membrane", "fit") == MEMBRANE]
+    rows = rows if len(rows) == len(done) else []
     for m in LEVELS[len(rows) :]:
         if roofs.settled([r["stiffness"] for r in rows], TOL):
             break
@@ -138,9 +149,25 @@ def refine(fam: str, state: float, done: list[dict], save=lambda rows: None) -> 
     return rows
 
 
-def summary(fam: str, state: float, rows: list[dict]) -> dict[str, Any]:
+def shell_reference(fam: str, state: float) -> list[dict]:
+    """The graded shell levels of one roof (``SHELL_LEVELS``, then refined further until
+    they settle within ``SHELL_DOF_BUDGET``; :func:`roofs.shell_extended`)."""
+    import barhinge as bh
+
+    cp, flat_xy, _ = roofs.folded(fam, state)
+    sv, se = roofs.support_lines(cp, flat_xy, roofs.FAMILIES[fam]["axis"])
+    base = bh.BarHingeModel.from_pattern(cp, "N5B8", roofs.material())
+    ck = roofs.crease_stiffness_per_length(base)
+    rows = [roofs.shell_level(cp, sv, se, r, ck, grading=roofs.SHELL_GRADING) for r in SHELL_LEVELS]
+    return roofs.shell_extended(cp, sv, se, ck, rows, SHELL_DOF_BUDGET)
+
+
+def summary(
+    fam: str, state: float, rows: list[dict], shell: list[dict] | None = None
+) -> dict[str, Any]:
     """A roof's refinement: the level it was refined to (or the budget), stiffness per width
-    there, the Richardson limit and its uncertainty, the buckling factors."""
+    there, the Richardson limit and its uncertainty, the buckling factors, and against the
+    ``shell`` levels (when given) the shell reference and the gap of the limit to it."""
     from barhinge.analysis.accuracy import richardson
 
     k = [r["stiffness"] for r in rows]
@@ -148,6 +175,10 @@ def summary(fam: str, state: float, rows: list[dict]) -> dict[str, Any]:
     refined = roofs.settled(k, TOL)
     limit, rate, corr = richardson(k)
     width = rows[-1]["plan_area"] / roofs.SPAN
+    ref, unc = float("nan"), math.inf
+    if shell:
+        ref, _, c = richardson([s_["stiffness"] for s_ in shell])
+        unc = abs(c / ref) if math.isfinite(c) else math.inf
     return {
         "family": fam,
         "state": state,
@@ -172,7 +203,12 @@ def summary(fam: str, state: float, rows: list[dict]) -> dict[str, Any]:
         "equilibrium_error": max(r["equilibrium_error"] for r in rows),
         "patch_residual": max(r["patch_residual"] for r in rows),
         "time_s": sum(r["time_s"] for r in rows),
-        "membrane_error": roofs.cell_membrane_error(roofs.folded(fam, state)[0]),
+        "membrane_error": roofs.cell_membrane_error(roofs.folded(fam, state)[0], MEMBRANE),
+        "bar_membrane_error": roofs.cell_membrane_error(roofs.folded(fam, state)[0], "fit"),
+        "shell": shell or [],
+        "shell_reference_per_width": ref / width,
+        "shell_uncertainty": unc,
+        "shell_gap": limit / ref - 1.0 if math.isfinite(limit) else k[-1] / ref - 1.0,
     }
 
 
@@ -194,7 +230,12 @@ def run(roof_list: list[tuple[str, float]], cache: Path | None) -> list[dict]:
                 cache.write_text(json.dumps(store, indent=0))
 
         rows = refine(fam, state, store.get(key, []), save)
-        out.append(summary(fam, state, rows))
+        skey = "shell|" + key
+        if skey not in store:
+            store[skey] = shell_reference(fam, state)
+            if cache is not None:
+                cache.write_text(json.dumps(store, indent=0))
+        out.append(summary(fam, state, rows, store[skey]))
     return out
 
 
@@ -220,13 +261,22 @@ def _limit(r: dict) -> str:
     return f"{r['limit_per_width'] / 1e3:.1f} ± {100 * r['limit_uncertainty']:.1f} %"
 
 
+def _shell(r: dict) -> str:
+    ref = r["shell_reference_per_width"] / 1e3
+    if not math.isfinite(ref):
+        return "—"
+    unc = r["shell_uncertainty"]
+    return f"{ref:.1f} ± {100 * unc:.1f} %" if math.isfinite(unc) else f"{ref:.1f} (not settled)"
+
+
 def table(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
     lines = [
         "| family | state | refined to | DOFs | last change | k / width, refined (kN/m/m) | "
         "limit (kN/m/m) | k / width, comparison table (kN/m/m) | table / refined − 1 | "
         "buckling factor, refined | its last change | buckling factor, comparison table | "
-        "membrane error of the cells |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "membrane error of the cells (bars `fit`) | shell reference (kN/m/m) | "
+        "limit / shell − 1 |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in results:
         c = coarse.get(_key(r["family"], r["state"]))
@@ -237,7 +287,8 @@ def table(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
             f"| {r['family']} | {r['state']:g} | {lvl} | {r['n_dof']} | {_pct(r['change'])} | "
             f"{r['stiffness_per_width'] / 1e3:.1f} | {_limit(r)} | {_f(kt / 1e3)} | "
             f"{_pct(kt / r['stiffness_per_width'] - 1.0)} | {_f(r['buckling_factor'], '.3f')} | "
-            f"{_pct(r['buckling_change'])} | {_f(bt, '.3f')} | {r['membrane_error']:.3f} |"
+            f"{_pct(r['buckling_change'])} | {_f(bt, '.3f')} | {r['membrane_error']:.3f} "
+            f"({r['bar_membrane_error']:.3f}) | {_shell(r)} | {_pct(r['shell_gap'])} |"
         )
     return "\n".join(lines)
 
@@ -357,6 +408,7 @@ def findings(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
             ),
             f"4. Every solve balances: largest equilibrium residual {eq:.1e}.",
             membrane_finding(results),
+            shell_finding(results),
         ]
     )
 
@@ -366,9 +418,21 @@ def membrane_finding(results: list[dict]) -> str:
     off = [r for r in results if r["membrane_error"] > MEMBRANE_TOL]
     good = [r for r in results if r["membrane_error"] <= MEMBRANE_TOL]
     if not off:
+        bars = sorted(results, key=lambda r: -r["bar_membrane_error"])
+        worst: dict[str, float] = {}
+        for r in bars:
+            worst.setdefault(r["family"], r["bar_membrane_error"])
+        off_bars = {f: e for f, e in worst.items() if e > MEMBRANE_TOL}
         return (
-            "5. **Membranes.** Every roof's cells store a uniform membrane strain within "
-            f"{max(r['membrane_error'] for r in results):.3f} of the plane-stress energy."
+            f"5. **Membranes.** The refined models have the `{MEMBRANE}` membrane: every "
+            "roof's cells store a uniform membrane strain within "
+            f"{max(r['membrane_error'] for r in results):.3f} of the plane-stress energy. "
+            "With bars instead (`fit`, the bracketed values), a panel cut into cells keeps "
+            "its shape's error (docs/calibration.md, Table 4), so refinement would converge "
+            "to a sheet whose membrane is off by that much in its worst direction: "
+            + "; ".join(f"{f} up to {e:.2f}" for f, e in off_bars.items())
+            + f" (the other roofs at most "
+            f"{max((e for f, e in worst.items() if f not in off_bars), default=0.0):.3f})."
         )
     fams: dict[str, list[float]] = {}
     for r in off:
@@ -381,6 +445,45 @@ def membrane_finding(results: list[dict]) -> str:
         + f" (column *membrane error of the cells*; the other roofs: at most "
         f"{max((r['membrane_error'] for r in good), default=0.0):.3f}). The refined stiffness"
         " and buckling factors of those roofs are indicative only; the ranking marks them."
+    )
+
+
+def shell_finding(results: list[dict]) -> str:
+    """Every roof's refined limit against its shell reference (``roofs.shell_level``)."""
+    have = [r for r in results if r["shell"]]
+    if not have:
+        return "6. **Against the shell.** No shell reference was computed."
+    settled = [r for r in have if r["shell_uncertainty"] <= SHELL_TOL]
+    within = [r for r in settled if abs(r["shell_gap"]) <= 0.05]
+    off = sorted((r for r in settled if abs(r["shell_gap"]) > 0.05), key=lambda r: r["shell_gap"])
+    open_ = [r for r in have if r["shell_uncertainty"] > SHELL_TOL]
+
+    def lab(r: dict) -> str:
+        return f"{r['family']} {r['state']:g}"
+
+    return (
+        "6. **Against the shell.** Every roof also has a shell reference (facet shell, meshes"
+        f" graded {roofs.SHELL_GRADING:g} towards the corners, r = {SHELL_LEVELS[0]} …"
+        f" {SHELL_LEVELS[-1]} and further until it settles, up to {SHELL_DOF_BUDGET:,} DOFs;"
+        " docs/roofs.md, *Against a shell model*). "
+        f"{len(settled)} of {len(have)} references settle to within {100 * SHELL_TOL:g} %; of"
+        f" those roofs, {len(within)} have a refined limit within 5 % of the shell"
+        + (
+            "; "
+            + ", ".join(f"{lab(r)} {_pct(r['shell_gap'])}" for r in off)
+            + " do not"
+            + (
+                " (all of them stopped at the DOF budget, finding 1)"
+                if all(not r["refined"] for r in off)
+                else " ("
+                + ", ".join(lab(r) for r in off if r["refined"])
+                + " refined to 2 %, the others stopped at the DOF budget, finding 1)"
+            )
+            if off
+            else ""
+        )
+        + "."
+        + (" Not settled: " + ", ".join(lab(r) for r in open_) + "." if open_ else "")
     )
 
 
@@ -447,12 +550,13 @@ def section(results: list[dict]) -> str:
             " `studies/roofs/refine_cache.json` as it is computed, so an interrupted run"
             " resumes; data: [roofs_refined.csv](roofs_refined.csv))."
             f" Every roof of the comparison table with each panel cut into m × m sub-panels"
-            f" (`{RULE}` plate rule), m = 1, 2, 4, … until the stiffness changes by less than"
-            f" {100 * TOL:g} % between two levels (a change of the same sign as the one before"
-            f" and smaller), or up to {DOF_BUDGET:,} DOFs. Stiffness and"
-            " width as in the comparison table (uniform load only); buckling factor under"
-            " the uniform load plus self-weight; limit = Richardson over the last three"
-            " levels (± its correction; *not settled* where the changes do not shrink).",
+            f" (`{RULE}` plate rule, `{MEMBRANE}` membrane), m = 1, 2, 4, … until the"
+            f" stiffness changes by less than {100 * TOL:g} % between two levels (a change"
+            " of the same sign as the one before and smaller), or up to"
+            f" {DOF_BUDGET:,} DOFs. Stiffness and width as in the comparison table (uniform"
+            " load only); buckling factor under the uniform load plus self-weight;"
+            " limit = Richardson over the last three levels (± its correction;"
+            " *not settled* where the changes do not shrink).",
             "",
             "![refinement of every roof](img/roofs_refined.png)",
             "",

@@ -372,12 +372,16 @@ def flat_line_stiffness(model, crease: np.ndarray) -> Any:
 #: ``BarHingeModel.from_pattern``. ``plate`` and ``kirchhoff`` are per-panel calibrations
 #: (flat lines get ``D l / s``); ``consistent`` and ``coupled`` then set every hinge inside
 #: and between sub-panels by :mod:`barhinge.model.plate_hinges` (the plate patch test;
-#: ``coupled`` also keeps the sheet's Poisson ratio), and converge to the plate
+#: ``coupled`` also keeps the sheet's Poisson ratio), and converge to the plate. ``coupled``,
+#: the refined model of the study, also has the constant-strain-triangle membrane
+#: (``REFINED_MEMBRANE``): bars cannot store a uniform strain in cells far from equilateral
+#: (docs/calibration.md, Table 4), and refinement keeps the cells' shape
+REFINED_MEMBRANE = "cst"
 BENDING_RULES: dict[str, dict[str, Any]] = {
     "plate": {},
     "kirchhoff": {"bend_calibration": "kirchhoff"},
     "consistent": {"bend_calibration": "kirchhoff"},
-    "coupled": {"bend_calibration": "kirchhoff"},
+    "coupled": {"bend_calibration": "kirchhoff", "bar_calibration": REFINED_MEMBRANE},
 }
 
 
@@ -405,12 +409,13 @@ def refinement_dofs(cp, m: int) -> int:
     return 3 * sum(subdivided_size(cp, m))
 
 
-def cell_membrane_error(cp) -> float:
-    """Worst relative energy error of the bar lattice under a uniform membrane strain, over the
-    homogeneous modes and the distinct face shapes of ``cp`` (one N5B8 panel each, the sheet's
-    material; :func:`barhinge.model.compare.panel_errors`). A panel cut into cells keeps its
-    shape's error (Table 4 of docs/calibration.md), so refinement converges to a sheet whose
-    membrane is off by about this much in its worst direction."""
+def cell_membrane_error(cp, bar_calibration: str = "fit") -> float:
+    """Worst relative energy error of the membrane ``bar_calibration`` under a uniform
+    membrane strain, over the homogeneous modes and the distinct face shapes of ``cp`` (one
+    N5B8 panel each, the sheet's material; :func:`barhinge.model.compare.panel_errors`). A
+    panel cut into cells keeps its shape's error (Table 4 of docs/calibration.md), so
+    refinement converges to a sheet whose membrane is off by about this much in its worst
+    direction (0 for the constant-strain triangle, ``"cst"``)."""
     from barhinge.model.calibrate import face_frames
     from barhinge.model.compare import panel_errors
 
@@ -423,9 +428,81 @@ def cell_membrane_error(cp) -> float:
         shapes.setdefault(tuple(np.round(Q / np.abs(Q).max(), 6).ravel()), Q)
     worst = 0.0
     for Q in shapes.values():
-        e = panel_errors(Q, material(), "N5B8", "fit", plate_refine=1)
+        e = panel_errors(Q, material(), "N5B8", bar_calibration, plate_refine=1)
         worst = max(worst, max(abs(v) for k, v in e.items() if k != "warp"))
     return worst
+
+
+#: the shell reference's facet meshes are graded towards the facets' corners (elements next
+#: to a pattern vertex h^2 long), where a folded sheet's stresses are singular
+SHELL_GRADING = 2.0
+
+
+def crease_stiffness_per_length(model) -> float:
+    """Fold-hinge stiffness per unit crease length of the M/V creases (uniform; 0 for a
+    pattern without any, such as the flat sheet)."""
+    asg = np.asarray(model.pattern.assignment)
+    X = np.asarray(model.X0)
+    h = model.hinges
+    f = (model.hinge_kind == "fold") & (model.hinge_edge >= 0)
+    f &= np.isin(asg[np.maximum(model.hinge_edge, 0)], ["M", "V"])
+    ell = np.linalg.norm(X[h[f, 1]] - X[h[f, 0]], axis=1)
+    k = model.hinge_k[f] / ell
+    if not len(k):
+        return 0.0
+    if not np.allclose(k, k[0], rtol=1e-9):
+        raise ValueError("crease stiffness per length is not uniform")
+    return float(k[0])
+
+
+def shell_level(
+    cp, sv, se, r: int, crease_k: float, sheet: Any = None, grading: float = 1.0
+) -> dict[str, Any]:
+    """Stiffness ``Q_t^2 / (f . u)`` of the facet shell roof (:mod:`barhinge.model.shell`)
+    at refinement ``r`` under the uniform load, creases of ``crease_k`` (moment per radian per
+    length), ``sheet`` the study's unless given, facet meshes of ``grading`` (1: uniform)."""
+    import time
+
+    from barhinge.model.shell import shell_model
+
+    t0 = time.perf_counter()
+    mat = material() if sheet is None else sheet
+    sh = shell_model(cp, mat, r, crease_stiffness=crease_k, grading=grading)
+    f = sh.surface_load((0.0, 0.0, -Q), per="plan")
+    u = sh.solve(f, np.union1d(sh.nodes_on_edges(se), sv))
+    Qt = float(-sh.translations(f)[:, 2].sum())
+    return {
+        "r": r,
+        "stiffness": Qt**2 / float(f @ u),
+        "n_dof": sh.n_dof,
+        "time_s": time.perf_counter() - t0,
+        "load": Qt,
+    }
+
+
+def shell_settled(rows: list[dict]) -> bool:
+    """Whether the shell levels ``rows`` give a reference: a Richardson estimate
+    (:func:`barhinge.analysis.accuracy.richardson`, order at least its ``MIN_ORDER``) whose
+    correction is below ``REFINE_TOL``."""
+    from barhinge.analysis.accuracy import richardson
+
+    if len(rows) < 3:
+        return False
+    ref, _, unc = richardson([s_["stiffness"] for s_ in rows])
+    return math.isfinite(unc) and unc <= REFINE_TOL * abs(ref)
+
+
+def shell_extended(
+    cp, sv, se, crease_k: float, rows: list[dict], budget: int, grading: float = SHELL_GRADING
+) -> list[dict]:
+    """The shell levels ``rows`` refined further (r + 1) until :func:`shell_settled` or the
+    next level would exceed ``budget`` DOFs (each level has about four times the DOFs of the
+    one before)."""
+    rows = list(rows)
+    while not shell_settled(rows) and 4 * rows[-1]["n_dof"] <= budget:
+        rows.append(shell_level(cp, sv, se, rows[-1]["r"] + 1, crease_k, grading=grading))
+        print(f"  shell r = {rows[-1]['r']}: {rows[-1]['stiffness'] / 1e3:.2f} kN/m", flush=True)
+    return rows
 
 
 def subdivided_roof(

@@ -55,10 +55,9 @@ VARIANTS = roofs.BENDING_RULES
 CONSISTENT = ("consistent", "coupled")
 #: the rule each roof is refined with for its limit (couplings: the sheet's Poisson ratio)
 MAIN_RULE = "coupled"
-#: the roofs' shell reference: facet meshes graded towards the corners (elements next to a
-#: pattern vertex h^2 long), where a folded sheet's stresses are singular; uniform meshes
-#: are refined beside it for comparison
-SHELL_GRADING = 2.0
+#: the roofs' shell reference: facet meshes graded towards the corners (``roofs.SHELL_GRADING``);
+#: uniform meshes are refined beside it for comparison
+SHELL_GRADING = roofs.SHELL_GRADING
 
 #: the main rule is refined past its fixed levels until its stiffness changes by less than
 #: ``roofs.REFINE_TOL`` or the next level would exceed this many DOFs
@@ -98,20 +97,6 @@ def support_sets(cp, flat_xy: np.ndarray, axis: int) -> tuple[np.ndarray, np.nda
     return roofs.support_lines(cp, flat_xy, axis)
 
 
-def crease_stiffness_per_length(model) -> float:
-    """Fold-hinge stiffness per unit crease length of the M/V creases (uniform)."""
-    asg = np.asarray(model.pattern.assignment)
-    X = np.asarray(model.X0)
-    h = model.hinges
-    f = (model.hinge_kind == "fold") & (model.hinge_edge >= 0)
-    f &= np.isin(asg[np.maximum(model.hinge_edge, 0)], ["M", "V"])
-    ell = np.linalg.norm(X[h[f, 1]] - X[h[f, 0]], axis=1)
-    k = model.hinge_k[f] / ell
-    if not np.allclose(k, k[0], rtol=1e-9):
-        raise ValueError("crease stiffness per length is not uniform")
-    return float(k[0])
-
-
 def bar_hinge(cp, sv, se, m: int, variant: str = "plate", scheme: str = "N5B8") -> dict:
     """Stiffness of the bar-and-hinge roof with m x m sub-panels (bending rule ``variant``,
     :func:`roofs.subdivided_roof`)."""
@@ -122,12 +107,13 @@ def bar_hinge(cp, sv, se, m: int, variant: str = "plate", scheme: str = "N5B8") 
     model, S, residual = roofs.subdivided_roof(cp, sv, se, m, variant, scheme)
     # the creases' own springs (the plate-consistent rules put them in series with the strip)
     base = bh.BarHingeModel.from_pattern(cp, scheme, roofs.material())
-    crease_k = crease_stiffness_per_length(base)
+    crease_k = roofs.crease_stiffness_per_length(base)
     F = roofs.plan_load(model, roofs.Q)
     U, _ = linear_response(model, F, S)
     Qt = float(-F[:, 2].sum())
     return {
         "m": m,
+        "membrane": membrane(variant),
         "stiffness": Qt**2 / float(np.sum(F * U)),
         "n_dof": 3 * model.n_nodes,
         "time_s": time.perf_counter() - t0,
@@ -136,24 +122,14 @@ def bar_hinge(cp, sv, se, m: int, variant: str = "plate", scheme: str = "N5B8") 
     }
 
 
-def shell(cp, sv, se, r: int, crease_k: float, material=None, grading: float = 1.0) -> dict:
-    """Stiffness of the facet shell roof at refinement r (``material``: the study's sheet
-    unless given; ``grading``: of the facet meshes, 1 uniform)."""
-    from barhinge.model.shell import shell_model
+def membrane(variant: str) -> str:
+    """The membrane (``bar_calibration``) of a bending rule's models."""
+    return roofs.BENDING_RULES[variant].get("bar_calibration", "fit")
 
-    t0 = time.perf_counter()
-    mat = roofs.material() if material is None else material
-    sh = shell_model(cp, mat, r, crease_stiffness=crease_k, grading=grading)
-    f = sh.surface_load((0.0, 0.0, -roofs.Q), per="plan")
-    u = sh.solve(f, np.union1d(sh.nodes_on_edges(se), sv))
-    Qt = float(-sh.translations(f)[:, 2].sum())
-    return {
-        "r": r,
-        "stiffness": Qt**2 / float(f @ u),
-        "n_dof": sh.n_dof,
-        "time_s": time.perf_counter() - t0,
-        "load": Qt,
-    }
+
+def shell(cp, sv, se, r: int, crease_k: float, material=None, grading: float = 1.0) -> dict:
+    """Stiffness of the facet shell roof at refinement r (:func:`roofs.shell_level`)."""
+    return roofs.shell_level(cp, sv, se, r, crease_k, material, grading)
 
 
 def navier_plate_stiffness(a: float, D: float, q: float, terms: int = 199) -> float:
@@ -330,22 +306,10 @@ def extended(cp, sv, se, rows: list[dict]) -> list[dict]:
     return rows
 
 
-def shell_settled(rows: list[dict]) -> bool:
-    """Whether the shell levels ``rows`` give a reference: a Richardson estimate (order at
-    least ``MIN_ORDER``) whose correction is below ``roofs.REFINE_TOL``."""
-    ref, _, unc = extrapolate([s_["stiffness"] for s_ in rows])
-    return len(rows) >= 3 and math.isfinite(unc) and unc <= roofs.REFINE_TOL * abs(ref)
-
-
 def shell_extended(cp, sv, se, crease_k: float, rows: list[dict]) -> list[dict]:
-    """The graded shell levels ``rows`` refined further (r + 1) until :func:`shell_settled`
-    or the next level would exceed ``SHELL_DOF_BUDGET`` (each level has about four times the
-    DOFs of the one before)."""
-    rows = list(rows)
-    while not shell_settled(rows) and 4 * rows[-1]["n_dof"] <= SHELL_DOF_BUDGET:
-        rows.append(shell(cp, sv, se, rows[-1]["r"] + 1, crease_k, grading=SHELL_GRADING))
-        print(f"  shell r = {rows[-1]['r']}: {rows[-1]['stiffness'] / 1e3:.2f} kN/m", flush=True)
-    return rows
+    """The graded shell levels ``rows`` refined further until they settle, within
+    ``SHELL_DOF_BUDGET`` (:func:`roofs.shell_extended`)."""
+    return roofs.shell_extended(cp, sv, se, crease_k, rows, SHELL_DOF_BUDGET, SHELL_GRADING)
 
 
 def refined_until(rows: list[dict], tol: float = roofs.REFINE_TOL) -> dict:
@@ -381,6 +345,7 @@ def derive(raw: dict) -> dict:
     ``n4b5``, ``shell``, ``shell_uniform``): the shell references, the errors and rates
     against the graded one, the bar-and-hinge limit and the refinement to 2 %."""
     bhr, n4b5, shr, shu = raw["bar_hinge"], raw["n4b5"], raw["shell"], raw["shell_uniform"]
+    cp = roofs.folded(raw["family"], raw["state"])[0]
     ref, p, unc = extrapolate([s["stiffness"] for s in shr])
     ref_u, p_u, unc_u = extrapolate([s["stiffness"] for s in shu])
     errors, rates = {}, {}
@@ -418,7 +383,8 @@ def derive(raw: dict) -> dict:
         "consistent_uncertainty": bh_unc / bh_ref,
         "refined": refined_until(bhr[MAIN_RULE]),
         "patch_residual": max(b["patch_residual"] for b in bhr[MAIN_RULE]),
-        "membrane_error": roofs.cell_membrane_error(roofs.folded(raw["family"], raw["state"])[0]),
+        "membrane_error": roofs.cell_membrane_error(cp, membrane(MAIN_RULE)),
+        "bar_membrane_error": roofs.cell_membrane_error(cp, "fit"),
     }
 
 
@@ -457,7 +423,7 @@ def membrane_bending_split(
     import barhinge as bh
 
     model = bh.BarHingeModel.from_pattern(cp, "N5B8", roofs.material())
-    ck = crease_stiffness_per_length(model)
+    ck = roofs.crease_stiffness_per_length(model)
     out = {}
     for name, mat in split_materials().items():
         k = [shell(cp, sv, se, r, ck, mat, grading)["stiffness"] for r in levels]
@@ -472,6 +438,11 @@ if CACHE and Path(CACHE).exists():
         rows = r["bar_hinge"][MAIN_RULE]
         cp, flat_xy, _ = roofs.folded(r["family"], r["state"])
         sv, se = support_sets(cp, flat_xy, roofs.FAMILIES[r["family"]]["axis"])
+        if any(b.get("membrane", "fit") != membrane(MAIN_RULE) for b in rows):
+            # cached with another membrane: the main rule's levels again
+            rows = [bar_hinge(cp, sv, se, m, MAIN_RULE) for m in LEVELS[MAIN_RULE]]
+            r["bar_hinge"][MAIN_RULE] = rows
+            Path(CACHE).write_text(json.dumps([RESULTS, PLATE]))
         r["bar_hinge"][MAIN_RULE] = extended(cp, sv, se, rows)
         n_shell = len(r["shell"])  # and the shell reference, where it has not settled
         ck = r["bar_hinge"]["plate"][0]["crease_k"]
@@ -591,7 +562,7 @@ def refinement_table(results: list[dict]) -> str:
     """Per roof: the ``MAIN_RULE`` model refined until its stiffness changes < 2 %, its own
     extrapolated limit and rate, and the gap between that limit and the shell's."""
     lines = [
-        "| roof | state | cell patch residual / D | membrane error of the cells | "
+        "| roof | state | cell patch residual / D | membrane error of the cells (bars `fit`) | "
         "refined to (change < 2 %) | stiffness (kN/m) | "
         "bar-hinge limit (kN/m) | its rate | shell reference (kN/m) | limit / shell − 1 |",
         "|---|---|---|---|---|---|---|---|---|---|",
@@ -601,7 +572,7 @@ def refinement_table(results: list[dict]) -> str:
         lvl = f"m = {f['m']}" + ("" if f["converged"] else " (not reached: DOF budget)")
         lines.append(
             f"| {r['family']} | {r['state']:g} | {r['patch_residual']:.2f} | "
-            f"{r['membrane_error']:.3f} | {lvl} | "
+            f"{r['membrane_error']:.3f} ({r['bar_membrane_error']:.3f}) | {lvl} | "
             f"{f['stiffness'] / 1e3:.1f} | {r['consistent_reference'] / 1e3:.1f} ± "
             f"{100 * r['consistent_uncertainty']:.1f} % | {_num(r['consistent_rate'])} | "
             f"{_ref(r['shell_reference'], r['shell_uncertainty'])} | "
@@ -877,7 +848,8 @@ def chart(results: list[dict], path: Path) -> None:
             [x["time_s"] for x in r["shell"]],
             [max(abs(x["stiffness"] / ref - 1.0), 1e-4) for x in r["shell"]],
             "k^--",
-            label=f"shell (graded {SHELL_GRADING:g}), r = {SHELL_LEVELS[0]}…{SHELL_LEVELS[-1]}",
+            label=f"shell (graded {SHELL_GRADING:g}), "
+            f"r = {r['shell'][0]['r']}…{r['shell'][-1]['r']}",
         )
         if np.isfinite(r["shell_uncertainty"]):
             ax.axhline(r["shell_uncertainty"], color="grey", lw=0.8, ls=":")
@@ -906,11 +878,15 @@ def section(results: list[dict]) -> str:
             " hinge inside or between cells chosen so that each cell stores the plate energy"
             " of every uniform curvature up to a Gaussian-curvature term) and *coupled* (the"
             " angles of each cell also coupled, so that the energy is the plate's with the"
-            " sheet's ν); creases in series with the plate strip beside them; rate = slope of"
-            " log |error| against log m over m ≥ 2; shell rate = observed order in the element"
-            " size of the shell's own refinement (r: 2^r elements per facet edge, graded"
-            f" towards the facets' corners with grading {SHELL_GRADING:g}: the elements next"
-            " to a pattern vertex are h^2 long).",
+            f" sheet's ν; its models have the `{membrane(MAIN_RULE)}` membrane, the others"
+            " bars calibrated by `fit`); creases in series with the plate strip beside"
+            " them; rate = slope of log |error| against log m over m ≥ 2; shell rate ="
+            " observed order in the element size of the shell's own refinement (r: 2^r"
+            " elements per facet edge, graded towards the facets' corners with grading"
+            f" {SHELL_GRADING:g}: the elements next to a pattern vertex are h^2 long;"
+            f" r = {SHELL_LEVELS[0]} … {SHELL_LEVELS[-1]}, then further until the"
+            f" Richardson correction is below {100 * roofs.REFINE_TOL:g} % or the next"
+            f" level would exceed {SHELL_DOF_BUDGET:,} DOFs).",
             "",
             table(results),
             "",

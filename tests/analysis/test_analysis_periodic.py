@@ -223,3 +223,10 @@ def test_docs_example_runs_and_the_doc_table_matches_the_script():
 
     # the values to their printed digits; errors at round-off (~1e-9) may differ by machine
     np.testing.assert_allclose(numbers(body), numbers(table), rtol=2e-3, atol=1e-8)
+
+
+def test_cst_membrane_is_refused_with_a_named_reason():
+    """The cell weighs bars one by one; the CST membrane couples the sides of a triangle."""
+    _, model, T = _cell(1.0, 1.0, 60.0, 30.0, bar_calibration="cst")
+    with pytest.raises(ConfigError, match="CST membrane"):
+        periodic_cell(model, T)

@@ -37,7 +37,7 @@ def test_quick_subset_equals_the_docs_numbers(table) -> None:
     (6e-4 covers rounding only)."""
     doc = table.parse_doc((REPO / "docs" / "calibration.md").read_text(encoding="utf-8"))
     mrows, brows = table.membrane_rows(quick=True), table.bending_rows(quick=True)
-    assert len(mrows) == 39 and len(brows) == 11
+    assert len(mrows) == 52 and len(brows) == 11
     for r in mrows:
         got = doc[("membrane", r["shape"], r["scheme"], 0.3, r["rule"])]
         np.testing.assert_allclose(got, [r[m] for m in table.MODES], rtol=0, atol=6e-4)

@@ -119,3 +119,49 @@ def test_ranking_marks_roofs_whose_cells_miss_the_membrane(study) -> None:
     text = study.ranking(rows, {})
     assert text.count("indicative: cells' membrane error 0.70") == len(rows)
     assert "bar lattice's own limit" in study.membrane_finding(rows)
+
+
+def test_refined_models_have_the_exact_cst_membrane(study) -> None:
+    """The refinement's models couple the sides of each triangle (``cst``): every roof's cells
+    store a uniform membrane strain exactly, where bars (``fit``) miss the Yoshimura's by
+    more than half; the finding says both, and every cached level records its membrane."""
+    assert study.MEMBRANE == "cst"
+    for r in study.RESULTS:
+        assert r["membrane_error"] < 1e-9
+        assert {x["membrane"] for x in r["rows"]} == {"cst"}
+    yosh = next(r for r in study.RESULTS if r["family"] == "yoshimura")
+    assert yosh["bar_membrane_error"] > 0.5
+    text = study.membrane_finding(study.RESULTS)
+    assert "`cst` membrane" in text and f"yoshimura up to {yosh['bar_membrane_error']:.2f}" in text
+
+
+def test_levels_of_another_membrane_are_recomputed(study) -> None:
+    """A cache written with bars (levels without ``membrane: cst``) is not reused."""
+    stale = [dict(x, membrane="fit") for x in study.RESULTS[0]["rows"][:2]]
+    fam, state = study.RESULTS[0]["family"], study.RESULTS[0]["state"]
+    rows = study.refine(fam, state, stale)
+    assert {x["membrane"] for x in rows} == {"cst"}
+    assert [x["stiffness"] for x in rows] == [x["stiffness"] for x in study.RESULTS[0]["rows"]]
+
+
+def test_every_roof_has_its_shell_gap(study) -> None:
+    """The shell reference of each roof is the Richardson estimate of its graded shell levels
+    (``roofs.shell_level``, at least ``SHELL_LEVELS``), and the gap is the refined limit over
+    it, both per width; the table and the findings report them."""
+    import math
+
+    from barhinge.analysis.accuracy import richardson
+
+    for r in study.RESULTS:
+        rs = [s["r"] for s in r["shell"]]
+        assert rs[: len(study.SHELL_LEVELS)] == list(study.SHELL_LEVELS)
+        ref, _, corr = richardson([s["stiffness"] for s in r["shell"]])
+        width = r["rows"][-1]["plan_area"] / study.roofs.SPAN
+        assert r["shell_reference_per_width"] == pytest.approx(ref / width, rel=1e-12)
+        limit = r["limit_per_width"] * width
+        assert r["shell_gap"] == pytest.approx(limit / ref - 1.0, rel=1e-9)
+        if math.isfinite(corr):
+            assert r["shell_uncertainty"] == pytest.approx(abs(corr / ref), rel=1e-9)
+    text = study.table(study.RESULTS, {})
+    assert "limit / shell − 1" in text
+    assert "6. **Against the shell.**" in study.shell_finding(study.RESULTS)
