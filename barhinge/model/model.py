@@ -363,22 +363,8 @@ class BarHingeModel:
                     raise ConfigError(f"{name} must have shape {kw[name].shape}, got {val.shape}")
                 val = _ro(val)
             kw[name] = val
-        pairs, pk = kw["hinge_pairs"], kw["pair_k"]
-        if pairs.ndim != 2 or pairs.shape[1] != 2 or pk.shape != (len(pairs),):
-            raise ConfigError(
-                f"hinge_pairs must have shape (n, 2) and pair_k (n,), got {pairs.shape} and "
-                f"{pk.shape}"
-            )
-        if len(pairs) and (pairs.min() < 0 or pairs.max() >= len(kw["hinges"])):
-            raise ConfigError("hinge_pairs refers to a hinge the model does not have")
-        bpairs, bc = kw["bar_pairs"], kw["bar_pair_c"]
-        if bpairs.ndim != 2 or bpairs.shape[1] != 2 or bc.shape != (len(bpairs),):
-            raise ConfigError(
-                f"bar_pairs must have shape (n, 2) and bar_pair_c (n,), got {bpairs.shape} "
-                f"and {bc.shape}"
-            )
-        if len(bpairs) and (bpairs.min() < 0 or bpairs.max() >= len(kw["bars"])):
-            raise ConfigError("bar_pairs refers to a bar the model does not have")
+        _check_pairs(kw, "hinge_pairs", "pair_k", "hinges")
+        _check_pairs(kw, "bar_pairs", "bar_pair_c", "bars")
         new = BarHingeModel(**kw)
         # same connectivity: share the (expensive) scatter maps
         same = not {"bars", "hinges", "hinge_pairs", "bar_pairs"} & set(changes)
@@ -648,6 +634,20 @@ class BarHingeModel:
         return (
             f"BarHingeModel(scheme={self.scheme}, n_nodes={self.n_nodes}, n_bars={self.n_bars}, "
             f"fold_hinges={nf}, bend_hinges={self.n_hinges - nf}, fold_law={self.fold_law})"
+        )
+
+
+def _check_pairs(kw: dict[str, Any], pairs: str, values: str, of: str) -> None:
+    """Raise ConfigError unless ``kw[pairs]`` is (n, 2) indices into ``kw[of]`` and
+    ``kw[values]`` has one value per pair."""
+    P, v = kw[pairs], kw[values]
+    if P.ndim != 2 or P.shape[1] != 2 or v.shape != (len(P),):
+        raise ConfigError(
+            f"{pairs} must have shape (n, 2) and {values} (n,), got {P.shape} and {v.shape}"
+        )
+    if len(P) and (P.min() < 0 or P.max() >= len(kw[of])):
+        raise ConfigError(
+            f"{pairs} refers to {of} the model does not have (indices 0 .. {len(kw[of]) - 1})"
         )
 
 

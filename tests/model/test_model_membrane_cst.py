@@ -185,3 +185,16 @@ def test_bad_input_is_named():
         triangle_side_matrices(np.array([[[0, 0, 0], [1, 0, 0], [2, 0, 0.0]]]), MAT)
     with pytest.raises(ConfigError, match="not a bar"):
         cst_bar_matrix(np.eye(3), np.array([[0, 1, 2]]), np.array([[0, 1], [1, 2]]), MAT)
+
+
+def test_with_checks_the_bar_couplings():
+    model = BarHingeModel.from_pattern(panel(SHAPES["square"]), bar_calibration="cst")
+    with pytest.raises(ConfigError, match="bar_pairs refers to bars the model does not have"):
+        model.with_(bar_pairs=[[0, model.n_bars]], bar_pair_c=[1.0])
+    with pytest.raises(ConfigError, match=r"bar_pairs must have shape \(n, 2\)"):
+        model.with_(bar_pairs=[[0, 1]], bar_pair_c=[1.0, 2.0])
+    plain = model.with_(bar_pairs=np.zeros((0, 2), int), bar_pair_c=[])
+    X = np.asarray(model.X0) * [1.02, 0.99, 1.0]
+    eps = 0.5 * (np.sum((X[plain.bars[:, 1]] - X[plain.bars[:, 0]]) ** 2, 1) / plain.bar_L0**2 - 1)
+    bars_alone = 0.5 * np.sum(plain.bar_EA * plain.bar_L0 * eps**2)
+    assert plain.evaluate(X).energy_bars == pytest.approx(bars_alone, rel=1e-12)
