@@ -175,6 +175,7 @@ def summary(
     refined = roofs.settled(k, TOL)
     limit, rate, corr = richardson(k)
     width = rows[-1]["plan_area"] / roofs.SPAN
+    cp = roofs.folded(fam, state)[0]  # formed once (resch, waterbomb relax to their state)
     ref, unc = float("nan"), math.inf
     if shell:
         ref, _, c = richardson([s_["stiffness"] for s_ in shell])
@@ -203,8 +204,8 @@ def summary(
         "equilibrium_error": max(r["equilibrium_error"] for r in rows),
         "patch_residual": max(r["patch_residual"] for r in rows),
         "time_s": sum(r["time_s"] for r in rows),
-        "membrane_error": roofs.cell_membrane_error(roofs.folded(fam, state)[0], MEMBRANE),
-        "bar_membrane_error": roofs.cell_membrane_error(roofs.folded(fam, state)[0], "fit"),
+        "membrane_error": roofs.cell_membrane_error(cp, MEMBRANE),
+        "bar_membrane_error": roofs.cell_membrane_error(cp, "fit"),
         "shell": shell or [],
         "shell_reference_per_width": ref / width,
         "shell_uncertainty": unc,
