@@ -360,9 +360,9 @@ def fold_cmd(
         str | None,
         typer.Option(
             "--accuracy",
-            help="Run the lightest model (rigid form, N4B5, N5B8, subdivided panels) whose "
-            "estimated error meets this accuracy, e.g. 2%; the choice and its estimated "
-            "error go to the summary.",
+            help="Run the lightest model (rigid form, N4B5, N5B8, panels cut into m x m "
+            "cells) whose estimated error meets this accuracy, e.g. 2%; the choice and its "
+            "estimated error go to the summary (exit code 3 when no model meets it).",
         ),
     ] = None,
     accuracy_for: Annotated[
@@ -398,7 +398,12 @@ def fold_cmd(
         from barhinge.analysis.accuracy import scene_for_accuracy
 
         outs = tuple(o.strip() for o in accuracy_for.split(",") if o.strip())
-        scene, choice = scene_for_accuracy(scene, accuracy, outs or None)
+
+        def tried(name: str, n_dof: int, seconds: float) -> None:
+            err_console.print(f"  estimated with {name}: {n_dof:,} DOFs, {seconds:.1f} s",
+                              highlight=False, markup=False)  # fmt: skip
+
+        scene, choice = scene_for_accuracy(scene, accuracy, outs or None, on_level=tried)
         c = choice.chosen
         err_console.print(f"model for {100 * choice.accuracy:g} % in {', '.join(choice.outputs)}: "
                           f"{c.name} (estimated error {100 * c.error:.2g} %)",

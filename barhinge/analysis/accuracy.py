@@ -2,10 +2,13 @@
 (``barhinge fold --accuracy 2%``, :func:`choose_model`).
 
 Candidates, lightest first: the rigid form (rigid kinematics; no elastic deformation), N4B5,
-N5B8, and N5B8 with every panel cut into ``m x m`` cells (``m = 2, 4, 8, 16``;
-:func:`barhinge.pattern.subdivide.subdivided`) whose bend and flat-line hinges follow the
-plate-consistent rule of :mod:`barhinge.model.plate_hinges`. Creases keep the scene model's
-fold stiffness per unit length in every candidate.
+N5B8, and N5B8 with every panel cut into ``m x m`` cells (``m = 2, 4, 8, 16, 32``;
+:func:`barhinge.pattern.subdivide.subdivided`, up to ``MAX_DOFS``): the refined model
+(``REFINED_MODEL``) whose cells store the Kirchhoff plate energy of every uniform curvature
+(:func:`barhinge.model.plate_hinges.coupled_bending`) and the plane-stress energy of every
+uniform strain (``bar_calibration="cst"``, :mod:`barhinge.model.membrane`), the model the roof
+study checks against a shell model (docs/roofs.md). Creases keep the scene model's fold
+stiffness per unit length in every candidate.
 
 Error estimates (all computed here, from the linear response at the scene's reference state
 under its loads and supports):
@@ -18,7 +21,11 @@ under its loads and supports):
   the target (or ``max_m``).
 * the scene's vertex loads are read as a distributed load (:func:`_spread_loads`), so that
   every level carries the same load (point loads on a folded sheet have no converged
-  compliance: the membrane's displacement under a point force is log-singular).
+  compliance: the membrane's displacement under a point force is log-singular). A load
+  lumped from face loads (pressure, projected or self-weight, equal shares to the corners)
+  is read back exactly where the vertex loads determine the faces' loads (no more faces than
+  vertices, e.g. quadrilateral panels); on triangulated patterns the reading is the one
+  nearest the smoothed estimate that still lumps back to the scene's loads.
 * output ``"form"`` (node positions, relative to the size of the sheet): an elastic
   candidate's error is the change of its largest displacement against the reference over the
   bounding-box diagonal; the rigid form's error is the whole elastic displacement over that
@@ -40,9 +47,11 @@ import dataclasses
 import math
 import re
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
 
 from barhinge.errors import ConfigError, ConvergenceError
 
@@ -60,7 +69,11 @@ __all__ = [
 #: outputs an accuracy can be asked for
 OUTPUTS = ("stiffness", "displacement", "form")
 #: subdivision levels tried, coarsest first
-LEVELS = (2, 4, 8, 16)
+LEVELS = (2, 4, 8, 16, 32)
+#: no subdivision level with more DOFs than this is built (a linear solve of about 8 GB)
+MAX_DOFS = 1_500_000
+#: the subdivided candidates' model, as reported in a choice's summary
+REFINED_MODEL = "N5B8, m x m cells per panel, coupled plate hinges, cst membrane"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -93,6 +106,7 @@ class ModelChoice:
     outputs: tuple[str, ...]
     reference: dict[str, float]
     rate: dict[str, float]
+    refined_model: str = ""
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready record for the run summary."""
@@ -103,6 +117,7 @@ class ModelChoice:
             "outputs": list(self.outputs),
             "reference": self.reference,
             "observed_rate": self.rate,
+            "refined_model": self.refined_model,
             "candidates": [
                 {"model": c.name, "n_dof": c.n_dof, "estimated_error": c.errors, "time_s": c.time_s}
                 for c in self.candidates
@@ -163,11 +178,13 @@ def _crease_k_per_length(model) -> np.ndarray:
 
 def subdivided_scene(scene, m: int, scheme: str = "N5B8"):
     """The scene with its pattern cut into ``m x m`` cells (``m = 1``: the scene's pattern
-    with ``scheme``): plate-consistent bending (m > 1), the crease stiffness per length of
-    ``scene.model``, supports and loads kept on the pattern's vertices; a vertex added on an
-    edge whose two ends are supported is supported in the directions both ends share."""
+    with ``scheme``). For m > 1 the model is ``REFINED_MODEL`` (N5B8, coupled plate hinges,
+    cst membrane; ``scheme`` is not used); creases keep the crease stiffness per length of
+    ``scene.model``; supports and loads stay on the pattern's vertices, the loads read as a
+    distributed load (:func:`_spread_loads`); a vertex added on an edge whose two ends are
+    supported is supported in the directions both ends share."""
     from barhinge.model.model import BarHingeModel
-    from barhinge.model.plate_hinges import consistent_hinge_stiffness
+    from barhinge.model.plate_hinges import coupled_bending
     from barhinge.pattern.subdivide import subdivided
 
     base = scene.model
@@ -180,9 +197,12 @@ def subdivided_scene(scene, m: int, scheme: str = "N5B8"):
         return scene
     cp = base.pattern
     cpm, parent = subdivided(cp, m)
-    kw = {k: base.meta[k] for k in ("bar_calibration",) if k in base.meta}
-    cal = base.meta.get("bend_calibration", "filipov") if m == 1 else "kirchhoff"
-    model = BarHingeModel.from_pattern(cpm, scheme, base.material, bend_calibration=cal, **kw)
+    if m == 1:
+        keys = ("bar_calibration", "bend_calibration", "bend_coefficient")
+        kw = {k: base.meta[k] for k in keys if base.meta.get(k) is not None}
+    else:
+        scheme, kw = "N5B8", {"bar_calibration": "cst", "bend_calibration": "kirchhoff"}
+    model = BarHingeModel.from_pattern(cpm, scheme, base.material, **kw)
     # creases: the base model's stiffness per unit length, on every piece of the edge
     kpl = _crease_k_per_length(base)
     n_e = cp.n_edges
@@ -199,7 +219,7 @@ def subdivided_scene(scene, m: int, scheme: str = "N5B8"):
     k[on_parent] = kpl[pe[on_parent]] * ell[on_parent]
     model = model.with_(hinge_k=k)
     if m > 1:
-        model = model.with_(hinge_k=consistent_hinge_stiffness(model).hinge_k)
+        model = coupled_bending(model)
     nv = cp.n_vertices
     S = np.zeros((model.n_nodes, 3), bool)
     F = np.zeros((model.n_nodes, 3))
@@ -217,37 +237,68 @@ def subdivided_scene(scene, m: int, scheme: str = "N5B8"):
     return dataclasses.replace(scene, model=model, supports=S, loads=F, prescribed=None)
 
 
-def _face_areas(V: np.ndarray, faces) -> np.ndarray:
-    return np.array(
-        [
-            0.5 * np.linalg.norm(np.cross(V[list(f)], np.roll(V[list(f)], -1, 0)).sum(0))
-            for f in faces
-        ]
-    )
+def _face_lumping(V: np.ndarray, faces) -> sp.csr_matrix:
+    """(n_vertices, n_faces) matrix that lumps a load per unit area on every face equally to
+    the face's corners: entry ``(v, f) = area_f / corners_f`` for every corner v of f."""
+    sizes = np.fromiter((len(f) for f in faces), np.int64, len(faces))
+    corners = np.fromiter((v for f in faces for v in f), np.int64, int(sizes.sum()))
+    owner = np.repeat(np.arange(len(faces)), sizes)
+    start = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    nxt = np.arange(len(corners)) + 1
+    nxt[start + sizes - 1] = start  # each corner's successor around its face
+    twice_area = np.zeros((len(faces), 3))
+    np.add.at(twice_area, owner, np.cross(V[corners], V[corners[nxt]]))
+    area = 0.5 * np.linalg.norm(twice_area, axis=1)
+    w = (area / sizes)[owner]
+    return sp.csr_matrix((w, (corners, owner)), shape=(len(V), len(faces)))
+
+
+#: vertex loads are read back as face loads when lumping those reproduces them to this
+#: relative residual
+LUMPED_TOL = 1e-9
+
+
+def _face_densities(cp, Fv: np.ndarray) -> np.ndarray:
+    """(n_faces, 3) load per unit area of every face that reproduces the vertex loads ``Fv``
+    when lumped equally to the faces' corners: the smoothed estimate below corrected by the
+    least-squares change of smallest norm (a load built that way, e.g. pressure, projected or
+    self-weight, is read back exactly where the faces' loads are determined, at least as many
+    vertices as faces). Vertex loads that no face loads reproduce get the smoothed estimate:
+    each vertex's load over its tributary area (area / corners of the faces around it), each
+    face the mean of its corners."""
+    from scipy.sparse.linalg import lsqr
+
+    V = np.asarray(cp.vertices3d, float)
+    L = _face_lumping(V, cp.faces)
+    trib = np.asarray(L.sum(axis=1)).ravel()
+    dens = np.divide(Fv, trib[:, None], out=np.zeros_like(Fv), where=trib[:, None] > 0)
+    corner_of = sp.csr_matrix(L.T > 0, dtype=float)  # (n_faces, n_vertices)
+    q0 = (corner_of @ dens) / np.diff(corner_of.indptr)[:, None]
+    scale = float(np.abs(Fv).max(initial=0.0))
+    if scale == 0.0:
+        return q0
+    q = q0.copy()
+    for k in range(3):
+        r = Fv[:, k] - L @ q0[:, k]
+        if np.abs(r).max() > 0.0:
+            q[:, k] += lsqr(L, r, atol=1e-14, btol=1e-14, iter_lim=20 * L.shape[1])[0]
+    if np.abs(L @ q - Fv).max() <= LUMPED_TOL * scale:
+        return q
+    return q0
 
 
 def _spread_loads(cp, Fv: np.ndarray, cpm, m: int, n_nodes: int) -> np.ndarray:
     """(n_nodes, 3) loads of the subdivided pattern: the scene's vertex loads read as a
-    distributed load (each vertex's load over its tributary area, sum of area / corners of
-    the faces around it; each face carrying the mean of its corners' densities), lumped
-    equally to the corners of every cell. A uniform load lumped that way is reproduced."""
-    V = np.asarray(cp.vertices3d, float)
-    A = _face_areas(V, cp.faces)
-    trib = np.zeros(len(V))
-    for f, a in zip(cp.faces, A, strict=True):
-        trib[list(f)] += a / len(f)
-    dens = np.divide(Fv, trib[:, None], out=np.zeros_like(Fv), where=trib[:, None] > 0)
-    face_q = np.array([dens[list(f)].mean(axis=0) for f in cp.faces])
-    Vm = np.asarray(cpm.vertices3d, float)
-    cells = cpm.faces
-    Ac = _face_areas(Vm, cells)
+    distributed load (:func:`_face_densities`) and lumped equally to the corners of every
+    cell. At ``m = 1`` a load lumped from face loads is returned unchanged."""
+    q = _face_densities(cp, Fv)
+    Lm = _face_lumping(np.asarray(cpm.vertices3d, float), cpm.faces)
     parent = np.repeat(np.arange(cp.n_faces), m * m)
     F = np.zeros((n_nodes, 3))
-    for c, a, pf in zip(cells, Ac, parent, strict=True):
-        F[list(c)] += face_q[pf] * a / len(c)
+    F[: Lm.shape[0]] = Lm @ q[parent]
     # loads on vertices of no face (none in a valid pattern) are kept as they are
-    free = trib == 0
-    F[: len(V)][free] += Fv[free]
+    on_none = np.diff(_face_lumping(np.asarray(cp.vertices3d, float), cp.faces).indptr) == 0
+    F[: len(on_none)][on_none] += Fv[on_none]
     return F
 
 
@@ -277,10 +328,20 @@ def choose_model(
     scene,
     accuracy: float | str = 0.02,
     outputs: tuple[str, ...] | list[str] = ("stiffness",),
-    max_m: int = 16,
+    max_m: int = LEVELS[-1],
+    max_dofs: int = MAX_DOFS,
+    cache: dict[tuple[str, int], tuple[dict[str, float], int, float]] | None = None,
+    on_level: Callable[[str, int, float], None] | None = None,
 ) -> ModelChoice:
     """The lightest model of ``scene`` whose estimated error meets ``accuracy`` for every
     requested output (module docstring).
+
+    Parameters
+    ----------
+    max_m, max_dofs : the finest subdivision tried, and the most DOFs a level may have
+    cache : responses of levels already computed for this scene, keyed by (scheme, m); filled
+        in (several accuracies of one scene compute each level once)
+    on_level : called after each candidate with (name, DOFs, wall time in s)
 
     Raises
     ------
@@ -307,16 +368,25 @@ def choose_model(
     # the estimates are linear responses at the reference state: actuators play no part
     static = dataclasses.replace(scene, actuators=None)
 
+    memo = {} if cache is None else cache
+
     def run(scheme: str, m: int) -> dict[str, float]:
-        t0 = time.perf_counter()
-        vals, ndof = _response(subdivided_scene(static, m, scheme))
+        if (scheme, m) not in memo:
+            t0 = time.perf_counter()
+            vals, ndof = _response(subdivided_scene(static, m, scheme))
+            memo[scheme, m] = (vals, ndof, time.perf_counter() - t0)
+        vals, ndof, dt = memo[scheme, m]
         name = scheme if m == 1 else f"{scheme} m={m}"
-        runs.append((name, scheme, m, vals, ndof, time.perf_counter() - t0))
+        runs.append((name, scheme, m, vals, ndof, dt))
+        if on_level is not None:
+            on_level(name, ndof, dt)
         return vals
 
     for scheme in ("N4B5", "N5B8"):
         run(scheme, 1)
-    levels = [m for m in LEVELS if m <= max_m]
+    levels = [m for m in LEVELS if m <= max_m and _level_dofs(scene.model.pattern, m) <= max_dofs]
+    if not levels:
+        raise ConfigError(f"no subdivision level fits in max_dofs = {max_dofs} DOFs")
     seq: list[dict[str, float]] = []
     ref: dict[str, float] = {}
     rate: dict[str, float] = {}
@@ -343,7 +413,14 @@ def choose_model(
             f"no model up to m = {levels[-1]} meets the accuracy {100 * acc:g} %: the best "
             f"estimate is {100 * best.error:.2g} % ({best.name})"
         )
-    return ModelChoice(ok[0], tuple(cands), acc, outs, ref, rate)
+    return ModelChoice(ok[0], tuple(cands), acc, outs, ref, rate, REFINED_MODEL)
+
+
+def _level_dofs(cp, m: int) -> int:
+    """DOFs of the N5B8 model of ``cp`` cut into m x m cells, counted without building it."""
+    from barhinge.pattern.subdivide import subdivided_size
+
+    return 3 * sum(subdivided_size(cp, m))
 
 
 def _est(vals, ref, unc, size: float, out: str) -> float:
@@ -392,7 +469,12 @@ def _choose_actuated(scene, acc: float, outs: tuple[str, ...]) -> ModelChoice:
     return ModelChoice(chosen, (rigid, own), acc, outs, {}, {})
 
 
-def scene_for_accuracy(scene, accuracy: float | str, outputs: tuple[str, ...] | None = None):
+def scene_for_accuracy(
+    scene,
+    accuracy: float | str,
+    outputs: tuple[str, ...] | None = None,
+    on_level: Callable[[str, int, float], None] | None = None,
+):
     """(scene to run, ModelChoice): the scene rebuilt on the model :func:`choose_model` picks
     (the scene itself for the rigid form or the scene's own model). ``outputs`` default:
     the form for a scene driven by actuators alone, else the stiffness."""
@@ -400,7 +482,7 @@ def scene_for_accuracy(scene, accuracy: float | str, outputs: tuple[str, ...] | 
 
     if not outputs:
         outputs = ("form",) if form_only_model(scene)[0] == "rigid" else ("stiffness",)
-    ch = choose_model(scene, accuracy, outputs)
+    ch = choose_model(scene, accuracy, outputs, on_level=on_level)
     c = ch.chosen
     if c.name == "rigid" or (c.m == 1 and c.scheme == scene.model.scheme):
         return scene, ch
