@@ -147,10 +147,15 @@ MIN_ORDER = 0.3
 
 def richardson(values: list[float]) -> tuple[float, float, float]:
     """(reference, observed rate p in m, |correction|) from values on m, 2m, 4m...:
-    Richardson with ``p = log2(d1 / d2)`` of the last two differences when they shrink
-    monotonically; otherwise the finest value with the last change as its correction. A
-    sequence whose changes barely shrink (``p < MIN_ORDER``) is not in its asymptotic
-    range: the finest value with an unknown (infinite) correction."""
+
+    * the last two changes shrink with the same sign: Richardson with ``p = log2(d1 / d2)``;
+      a sequence whose changes barely shrink (``p < MIN_ORDER``) is not in its asymptotic
+      range: the finest value with an unknown (infinite) correction;
+    * they shrink with alternating signs: the finest value, bracketed by the last change
+      (its correction);
+    * they do not shrink (or fewer than three values): the finest value, correction unknown
+      (infinite): nothing says that the next change will be smaller than the last.
+    """
     if len(values) >= 3:
         d1, d2 = values[-2] - values[-3], values[-1] - values[-2]
         if d1 * d2 > 0 and abs(d2) < abs(d1):
@@ -159,8 +164,10 @@ def richardson(values: list[float]) -> tuple[float, float, float]:
                 return values[-1], p, math.inf
             corr = d2 / (2.0**p - 1.0)
             return values[-1] + corr, p, abs(corr)
-    if len(values) >= 2:
-        return values[-1], float("nan"), abs(values[-1] - values[-2])
+        if d1 * d2 < 0 and abs(d2) < abs(d1):
+            return values[-1], float("nan"), abs(d2)
+        if d2 == 0.0 and d1 == 0.0:
+            return values[-1], float("nan"), 0.0
     return values[-1], float("nan"), float("inf")
 
 

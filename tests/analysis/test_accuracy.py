@@ -241,3 +241,16 @@ def test_richardson_does_not_extrapolate_below_its_minimum_order():
     q = MIN_ORDER + 0.05
     ref, p, corr = richardson([3 + 2 * m**-q for m in (4, 8, 16)])
     assert ref == pytest.approx(3.0, rel=1e-12) and p == pytest.approx(q, rel=1e-12)
+
+
+def test_richardson_gives_no_error_bound_where_the_changes_grow():
+    """The miura60 75 roof's levels m = 2, 4, 8 (250.6, 238.9, 226.6 kN/m: changes -11.7,
+    -12.3) once passed for converged to 5.4 % with the last change as the bound, 21 % above
+    the shell; growing changes bound nothing (infinite correction). Alternating shrinking
+    changes bracket the limit: the last change bounds it. Two levels bound nothing."""
+    ref, p, corr = richardson([250.6, 238.9, 226.6])
+    assert ref == 226.6 and math.isinf(corr) and math.isnan(p)
+    ref, _, corr = richardson([10.0, 12.0, 11.0])  # 2, -1: alternating, shrinking
+    assert ref == 11.0 and corr == pytest.approx(1.0)
+    assert math.isinf(richardson([10.0, 11.0])[2])
+    assert richardson([5.0, 5.0, 5.0])[2] == 0.0
