@@ -49,11 +49,11 @@ minus the 6 rigid-body motions has the same dimension as the angle formulation's
 from __future__ import annotations
 
 import dataclasses
-from collections import deque
 from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components, dijkstra
 
 from barhinge.errors import PatternError
 from barhinge.pattern.crease import CreasePattern
@@ -67,15 +67,17 @@ __all__ = [
 
 # --------------------------------------------------------------------------- helpers
 def rodrigues(u: np.ndarray, phi: np.ndarray) -> np.ndarray:
-    """(k, 3, 3) rotations about unit axes ``u`` (k, 3) by angles ``phi`` (k,) radians."""
+    """(..., k, 3, 3) rotations about unit axes ``u`` (k, 3) by angles ``phi`` (..., k)
+    radians (a leading batch of angle sets shares the axes)."""
     c, s = np.cos(phi), np.sin(phi)
-    K = np.zeros(u.shape[:-1] + (3, 3))
-    K[..., 0, 1], K[..., 0, 2] = -u[..., 2], u[..., 1]
-    K[..., 1, 0], K[..., 1, 2] = u[..., 2], -u[..., 0]
-    K[..., 2, 0], K[..., 2, 1] = -u[..., 1], u[..., 0]
-    uu = u[:, :, None] * u[:, None, :]
-    eye = np.eye(3)
-    return c[:, None, None] * eye + s[:, None, None] * K + (1.0 - c)[:, None, None] * uu
+    R = (1.0 - c)[..., None, None] * (u[:, :, None] * u[:, None, :])
+    for i in range(3):
+        R[..., i, i] += c
+    # + sin(phi) [u]x
+    for i, j, k, sign in ((0, 1, 2, -1.0), (0, 2, 1, 1.0), (1, 2, 0, -1.0)):
+        R[..., i, j] += sign * s * u[:, k]
+        R[..., j, i] -= sign * s * u[:, k]
+    return R
 
 
 def triangulated_pattern(cp: CreasePattern) -> tuple[CreasePattern, np.ndarray]:
@@ -507,12 +509,16 @@ class RigidConstraints:
         return FaceTree.build(self)
 
     def coordinates(self, rho: np.ndarray) -> np.ndarray:
-        """(n_vertices, 3) coordinates rebuilt from fold angles ``rho`` (n_var,) radians.
+        """(n_vertices, 3) coordinates rebuilt from fold angles ``rho`` (n_var,) radians, or
+        (n_states, n_vertices, 3) from a batch of states (n_states, n_var).
 
         The root face keeps its reference position; every other face is its parent turned
         about the shared crease by the change of fold angle. Each vertex takes its position
         from one face, so shared vertices agree only where the constraints hold.
         """
+        rho = np.asarray(rho, dtype=float)
+        if rho.ndim == 2 and rho.shape[1] == self.n_var:
+            return self.face_tree.coordinates(rho - self.rho0)
         return self.face_tree.coordinates(self.full_angles(rho) - self.rho0)
 
     def angles_of_edges(self, rho: np.ndarray) -> np.ndarray:
@@ -541,14 +547,21 @@ def _vee_skew(F: np.ndarray) -> np.ndarray:
     )
 
 
+#: a face tree with more levels than this is composed by pointer doubling (a Python
+#: iteration per level costs more than ``log2`` rounds over all faces)
+DOUBLING_DEPTH = 512
+
+
 @dataclasses.dataclass(frozen=True, eq=False)
 class FaceTree:
-    """BFS spanning tree of the faces, composed by pointer doubling (vectorised).
+    """BFS spanning tree of the faces, composed level by level (vectorised).
 
     Each non-root face ``f`` is its parent turned about the line ``X0[a_f] -> X0[b_f]`` (the
     shared crease) by ``sign_f * (rho - rho0)[var_f]``; ``sign_f = +1`` when ``f`` is on the
     left of the directed edge (a valley lifts the left face towards the normals). Poses are
-    composed along the tree in ``ceil(log2(depth))`` batched rounds.
+    composed one tree level at a time, all faces of a level (and all states of a batch) in
+    one product; a tree deeper than ``DOUBLING_DEPTH`` levels is composed by pointer
+    doubling instead, in ``ceil(log2(depth))`` rounds over all faces.
 
     Attributes
     ----------
@@ -575,11 +588,8 @@ class FaceTree:
         pat = rc.pattern
         X0 = pat.vertices3d
         nf = pat.n_faces
-        adj: list[list[tuple[int, int]]] = [[] for _ in range(nf)]
-        for fl, fr, e in pat.face_adjacency:
-            if rc.var_of_edge[e] >= 0:
-                adj[fl].append((int(fr), int(e)))
-                adj[fr].append((int(fl), int(e)))
+        adjacency = np.asarray(pat.face_adjacency, dtype=np.int64).reshape(-1, 3)
+        adjacency = adjacency[rc.var_of_edge[adjacency[:, 2]] >= 0]
         sizes = np.fromiter((len(f) for f in pat.faces), dtype=np.int64, count=nf)
         flat_idx = np.fromiter((i for f in pat.faces for i in f), dtype=np.int64)
         owner = np.repeat(np.arange(nf), sizes)
@@ -590,27 +600,33 @@ class FaceTree:
             / sizes[:, None]
         )
         order_pref = np.argsort(np.linalg.norm(cent - cent.mean(0), axis=1), kind="stable")
-        depth = -np.ones(nf, dtype=np.int64)
-        parent = -np.ones(nf, dtype=np.int64)
+        # one crease per pair of faces (the first), as a graph of the faces
+        lo = np.minimum(adjacency[:, 0], adjacency[:, 1])
+        hi = np.maximum(adjacency[:, 0], adjacency[:, 1])
+        key, first = np.unique(lo * nf + hi, return_index=True)
+        graph = sp.csr_matrix(
+            (np.ones(len(key)), (lo[first], hi[first])), shape=(nf, nf)
+        )  # fmt: skip
+        # breadth-first from one root per connected part (its face nearest the centroid)
+        _, part = connected_components(graph, directed=False)
+        roots = order_pref[np.unique(part[order_pref], return_index=True)[1]]
+        dist, pred, _ = dijkstra(
+            graph, directed=False, indices=roots, unweighted=True,
+            return_predecessors=True, min_only=True,
+        )  # fmt: skip
+        depth = dist.astype(np.int64)
+        parent = np.where(pred >= 0, pred, -1).astype(np.int64)
+        child = np.flatnonzero(parent >= 0)
+        pair = np.minimum(parent[child], child) * nf + np.maximum(parent[child], child)
         via = np.zeros(nf, dtype=np.int64)
-        for start in order_pref:
-            if depth[start] >= 0:
-                continue
-            depth[start] = 0
-            q = deque([int(start)])
-            while q:
-                f = q.popleft()
-                for g, e in adj[f]:
-                    if depth[g] < 0:
-                        depth[g] = depth[f] + 1
-                        parent[g] = f
-                        via[g] = e
-                        q.append(g)
+        via[child] = adjacency[first[np.searchsorted(key, pair)], 2]
         E, EF = pat.edges, pat.edge_faces
         sign = np.where(EF[via, 0] == np.arange(nf), 1.0, -1.0)
+        # every vertex takes the shallowest face holding it (the lowest index among equals)
         vertex_face = -np.ones(pat.n_vertices, dtype=np.int64)
-        for fi in np.argsort(depth, kind="stable")[::-1]:
-            vertex_face[list(pat.faces[fi])] = fi
+        by_depth = np.lexsort((owner, depth[owner]))
+        held, at = np.unique(flat_idx[by_depth], return_index=True)
+        vertex_face[held] = owner[by_depth][at]
         return cls(
             X0=X0,
             parent=parent,
@@ -629,35 +645,53 @@ class FaceTree:
         n = np.linalg.norm(u, axis=1, keepdims=True)
         return p, u / np.where(n > 0, n, 1.0)
 
+    @cached_property
+    def _levels(self) -> list[np.ndarray]:
+        """The non-root faces grouped by depth, shallowest first."""
+        order = np.argsort(self.depth, kind="stable")
+        order = order[self.depth[order] > 0]
+        cuts = np.flatnonzero(np.diff(self.depth[order])) + 1
+        return np.split(order, cuts) if order.size else []
+
     def poses(self, drho: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Face poses ``x = R x0 + t`` for fold-angle changes ``drho`` (n_var,) radians:
-        R (n_faces, 3, 3), t (n_faces, 3)."""
+        """Face poses ``x = R x0 + t`` for fold-angle changes ``drho`` (n_var,) or a batch
+        (n_states, n_var), radians: R (..., n_faces, 3, 3), t (..., n_faces, 3)."""
         p, u = self._axes
-        R = rodrigues(u, self.sign * drho[self.var])
-        t = p - (R @ p[:, :, None])[:, :, 0]
+        R = rodrigues(u, self.sign * np.asarray(drho)[..., self.var])
+        t = p - np.einsum("...fij,fj->...fi", R, p)
+        root = self.parent < 0
+        R[..., root, :, :] = np.eye(3)
+        t[..., root, :] = 0.0
+        if len(self._levels) <= DOUBLING_DEPTH:
+            # (R, t) of a level's faces: their parent's pose after their own turn
+            for f in self._levels:
+                g = self.parent[f]
+                Rg = R[..., g, :, :]
+                t[..., f, :] = np.einsum("...fij,...fj->...fi", Rg, t[..., f, :]) + t[..., g, :]
+                R[..., f, :, :] = Rg @ R[..., f, :, :]
+            return R, t
         anc = self.parent.copy()
-        root = anc < 0
-        R[root] = np.eye(3)
-        t[root] = 0.0
         # pointer doubling: (R, t) maps face frame -> frame of ancestor anc
         while True:
             live = np.flatnonzero(anc >= 0)
             if live.size == 0:
                 break
             g = anc[live]
-            Rg, tg = R[g], t[g]
-            t[live] = (Rg @ t[live][:, :, None])[:, :, 0] + tg
-            R[live] = Rg @ R[live]
+            Rg, tg = R[..., g, :, :], t[..., g, :]
+            t[..., live, :] = np.einsum("...fij,...fj->...fi", Rg, t[..., live, :]) + tg
+            R[..., live, :, :] = Rg @ R[..., live, :, :]
             anc[live] = anc[g]
         return R, t
 
     def coordinates(self, drho: np.ndarray) -> np.ndarray:
-        """(n, 3) vertex coordinates for fold-angle changes ``drho`` (n_var,) radians."""
+        """(..., n, 3) vertex coordinates for fold-angle changes ``drho`` (n_var,) or a batch
+        (n_states, n_var), radians."""
         R, t = self.poses(drho)
         vf = self.vertex_face
-        X = self.X0.copy()
         ok = vf >= 0
-        X[ok] = (R[vf[ok]] @ self.X0[ok][:, :, None])[:, :, 0] + t[vf[ok]]
+        X = np.broadcast_to(self.X0, R.shape[:-3] + self.X0.shape).copy()
+        f = vf[ok]
+        X[..., ok, :] = np.einsum("...vij,vj->...vi", R[..., f, :, :], self.X0[ok]) + t[..., f, :]
         return X
 
 

@@ -1258,7 +1258,10 @@ def _make_path(
     rc, opt = solver.rc, solver.opt
     R = np.asarray(states)
     n = len(R)
-    X = np.stack([rc.coordinates(r) for r in R])
+    # every state's coordinates in one composition of the face tree, in chunks of at most
+    # ~4e6 face poses (0.3 GB of rotations)
+    chunk = max(1, 4_000_000 // max(rc.pattern.n_faces, 1))
+    X = np.concatenate([rc.coordinates(R[i : i + chunk]) for i in range(0, n, chunk)])
     ang = np.stack([rc.angles_of_edges(r) for r in R])
     closure = [float(rc.closure_error(r).max()) if len(rc.vertices) else 0.0 for r in R]
     meta = {
