@@ -30,6 +30,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import msgspec
 import numpy as np
 
 from barhinge.errors import PatternError
@@ -409,6 +410,13 @@ def write_fold_path(cp: CreasePattern, fold_path: FoldPath, path: str | Path) ->
     n, m = cp.n_vertices, cp.n_edges
     if X.ndim != 3 or X.shape[1] < n:
         raise PatternError(f"fold path has nodes of shape {X.shape}; expected (k, >= {n}, 3)")
+    bad = np.argwhere(~np.isfinite(X[:, :n]))
+    if len(bad):
+        s, v, _ = bad[0]
+        raise PatternError(
+            f"{Path(path).name}: cannot write FOLD (state {s}: vertex {v} has a non-finite "
+            "coordinate)"
+        )
     A = np.asarray(fold_path.fold_angles_deg, float)
     if A.shape != (X.shape[0], m):
         raise PatternError(f"fold path fold angles have shape {A.shape}; expected ({len(X)}, {m})")
@@ -435,7 +443,11 @@ def write_fold_path(cp: CreasePattern, fold_path: FoldPath, path: str | Path) ->
         frames.append(fr)
     d["file_frames"] = frames
     d["barhinge:path_kind"] = fold_path.kind
-    return _dump(d, path, indent=None)  # one line: json's C encoder, ~10x faster for many frames
+    # one line, by msgspec's encoder (~20x faster than json's for many frames; the
+    # coordinates are checked finite above, NaN fold angles are None already)
+    path = Path(path)
+    path.write_bytes(msgspec.json.encode(d) + b"\n")
+    return path
 
 
 def read_fold_path(

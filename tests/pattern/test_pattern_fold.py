@@ -126,6 +126,12 @@ def test_fold_path_round_trip(tmp_path: Path) -> None:
     np.testing.assert_allclose(s2.vertices, X[2], rtol=0, atol=ATOL)
     np.testing.assert_allclose(s2.fold_angles, A[2], rtol=0, atol=ATOL)
     assert data["file_frames"][1]["edges_foldAngle"][0] is None
+    # the numbers survive the file exactly (shortest round-trip decimal form)
+    np.testing.assert_array_equal(X2, X)
+    # a coordinate that is not finite has no JSON form: refused, naming the state and vertex
+    X[2, 3, 1] = np.inf
+    with pytest.raises(PatternError, match="state 2: vertex 3 has a non-finite coordinate"):
+        write_fold_path(cp, FoldPath(X=X, fold_angles_deg=A, kind="rigid"), tmp_path / "b.fold")
 
 
 @pytest.mark.parametrize(
