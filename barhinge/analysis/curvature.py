@@ -203,11 +203,16 @@ def local_curvatures(
 def corner_angles(X: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     """(n_tri, 3) float radians: interior angle of each triangle at each of its corners."""
     P = X[triangles]  # (t, 3 corners, 3 xyz)
-    a = np.roll(P, -1, axis=1) - P
-    b = np.roll(P, 1, axis=1) - P
-    cos = np.einsum("tcx,tcx->tc", a, b)
-    sin = np.linalg.norm(np.cross(a, b), axis=2)
-    return np.arctan2(sin, cos)
+    a = P[:, _NEXT] - P
+    b = P[:, _PREV] - P
+    dot = np.einsum("tcx,tcx->tc", a, b)
+    # |a x b| is twice the triangle's area at every corner
+    twice_area = np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1)
+    return np.arctan2(np.broadcast_to(twice_area[:, None], dot.shape), dot)
+
+
+#: the next and the previous corner of each corner of a triangle
+_NEXT, _PREV = np.array([1, 2, 0]), np.array([2, 0, 1])
 
 
 def mixed_voronoi_area(X: np.ndarray, triangles: np.ndarray) -> np.ndarray:
@@ -223,14 +228,12 @@ def mixed_voronoi_area(X: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     P = X[T]
     area = 0.5 * np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1)
     # squared length of the side opposite each corner c: between corners c+1 and c+2
-    opp = np.roll(P, -1, axis=1) - np.roll(P, 1, axis=1)
+    opp = P[:, _NEXT] - P[:, _PREV]
     l2 = np.einsum("tcx,tcx->tc", opp, opp)
     cot = 1.0 / np.tan(np.clip(ang, 1e-12, np.pi - 1e-12))
     # corner c: sides to c+1 and c+2 are opposite c+2 and c+1 respectively
-    vor = (
-        np.roll(l2, -1, axis=1) * np.roll(cot, -1, axis=1)
-        + np.roll(l2, 1, axis=1) * np.roll(cot, 1, axis=1)
-    ) / 8.0
+    lc = l2 * cot
+    vor = (lc[:, _NEXT] + lc[:, _PREV]) / 8.0
     obtuse = ang > 0.5 * np.pi
     any_obtuse = obtuse.any(axis=1, keepdims=True)
     A = np.where(any_obtuse, np.where(obtuse, 0.5, 0.25) * area[:, None], vor)
