@@ -254,3 +254,27 @@ def test_richardson_gives_no_error_bound_where_the_changes_grow():
     assert ref == 11.0 and corr == pytest.approx(1.0)
     assert math.isinf(richardson([10.0, 11.0])[2])
     assert richardson([5.0, 5.0, 5.0])[2] == 0.0
+
+
+def test_cli_fold_accuracy_on_a_loaded_scene(tmp_path, capsys):
+    """A loaded scene (the shipped Yoshimura roof under self-weight): every candidate is
+    reported as it is estimated, the run uses the refined model, and its summary names it;
+    a target no level up to the DOF budget meets exits with code 3."""
+    import json
+    from pathlib import Path
+
+    from barhinge.cli import main
+
+    scene = Path(__file__).resolve().parents[2] / "data" / "scenes" / "yoshimura_roof.toml"
+    out = tmp_path / "roof"
+    args = ["fold", str(scene), "--out", str(out), "--accuracy", "10%", "--no-viewer"]
+    main([*args, "--pictures", "none"])
+    err = capsys.readouterr().err
+    assert "estimated with N4B5" in err and "estimated with N5B8 m=2" in err
+    choice = json.loads((out / "summary.json").read_text())["model_choice"]
+    assert choice["refined_model"].startswith("N5B8") and choice["model"].startswith("N5B8 m=")
+    assert all(c["estimated_error"]["stiffness"] > 0.10 for c in choice["candidates"][:3])
+    with pytest.raises(SystemExit) as exc:
+        main(["fold", str(scene), "--out", str(tmp_path / "strict"), "--accuracy", "0.01%"])
+    assert exc.value.code == 3
+    assert "no model up to m = 32 meets the accuracy 0.01 %" in capsys.readouterr().err
