@@ -17,8 +17,10 @@ under its loads and supports):
   ``"displacement"`` (largest nodal displacement): the subdivided levels are extrapolated to
   ``m -> infinity`` (Richardson, observed rate of the three finest levels computed); a
   candidate's estimated error is its distance to that reference plus the extrapolation's own
-  correction (the uncertainty of the reference). Levels are refined until the finest meets
-  the target (or ``max_m``).
+  correction (the uncertainty of the reference). The reference is trusted only in the
+  asymptotic range (:func:`in_asymptotic_range`: four levels at least, the observed orders of
+  the last two triples within a factor 2); before that every estimate is unknown. Levels are
+  refined until the finest meets the target (or ``max_m``, ``max_dofs``).
 * the scene's vertex loads are read as a distributed load (:func:`_spread_loads`), so that
   every level carries the same load (point loads on a folded sheet have no converged
   compliance: the membrane's displacement under a point force is log-singular). A load
@@ -60,6 +62,7 @@ __all__ = [
     "Candidate",
     "ModelChoice",
     "choose_model",
+    "in_asymptotic_range",
     "parse_accuracy",
     "richardson",
     "scene_for_accuracy",
@@ -143,6 +146,26 @@ def parse_accuracy(text: str | float) -> float:
 #: observed orders below this are not extrapolated by :func:`richardson`: the correction
 #: would exceed ``1 / (2^p - 1)`` = 4.3 times the last change
 MIN_ORDER = 0.3
+
+
+#: the extrapolation of a refinement is trusted when the observed order of its three finest
+#: levels is within this factor of the order of the three before (:func:`in_asymptotic_range`)
+ORDER_RATIO = 2.0
+
+
+def in_asymptotic_range(values: list[float]) -> bool:
+    """Whether a refinement (values on m, 2m, 4m, ...) is in its asymptotic range: at least
+    four levels, both triples of the finest extrapolate (:func:`richardson`) and their
+    observed orders agree within ``ORDER_RATIO`` (the check of the asymptotic range of
+    Roache 1994, J. Fluids Eng. 116:405). A sequence whose first changes happen to shrink
+    like a power law before its pre-asymptotic part is over fails it."""
+    if len(values) < 4:
+        return False
+    _, p1, c1 = richardson(values)
+    _, p0, c0 = richardson(values[:-1])
+    if not (math.isfinite(c1) and math.isfinite(c0) and p1 > 0 and p0 > 0):
+        return False
+    return 1.0 / ORDER_RATIO <= p1 / p0 <= ORDER_RATIO
 
 
 def richardson(values: list[float]) -> tuple[float, float, float]:
@@ -401,7 +424,10 @@ def choose_model(
     for m in levels:
         seq.append(run("N5B8", m))
         for q in ("stiffness", "displacement"):
-            ref[q], rate[q], unc[q] = richardson([v[q] for v in seq])
+            vals = [v[q] for v in seq]
+            ref[q], rate[q], unc[q] = richardson(vals)
+            if not in_asymptotic_range(vals):
+                unc[q] = math.inf  # not yet trusted: refine further
         if len(seq) >= 3 and all(_est(seq[-1], ref, unc, size, o) <= acc for o in outs):
             break
     cands = [
