@@ -327,7 +327,8 @@ def _spread_loads(cp, Fv: np.ndarray, cpm, m: int, n_nodes: int) -> np.ndarray:
     F = np.zeros((n_nodes, 3))
     F[: Lm.shape[0]] = Lm @ q[parent]
     # loads on vertices of no face (none in a valid pattern) are kept as they are
-    on_none = np.diff(_face_lumping(np.asarray(cp.vertices3d, float), cp.faces).indptr) == 0
+    on_none = np.ones(len(Fv), bool)
+    on_none[[v for f in cp.faces for v in f]] = False
     F[: len(on_none)][on_none] += Fv[on_none]
     return F
 
