@@ -106,6 +106,11 @@ class SolverOptions:
     arc_stop_limit_points : int or None
         Arc length stops at the first state past this many limit points of the load
         factor (turning points of the load-factor path).
+    arc_stop_instability : bool
+        Arc length stops at the first state whose free tangent has more negative eigenvalues
+        than the starting state's: the first loss of stability on the path, a bifurcation
+        or a limit point passed (``FoldPath.meta["arc_stop"]["value"]`` is its load factor).
+        Default False.
     stability_check : bool or None
         How the inertia of the free-DOF tangent (its number of negative eigenvalues, actuators
         released) is found at every recorded state (``FoldPath.meta["negative_eigenvalues"]``
@@ -145,6 +150,7 @@ class SolverOptions:
     arc_stop_load_factor: float | None = None
     arc_stop_displacement: dict[str, Any] | None = None
     arc_stop_limit_points: int | None = None
+    arc_stop_instability: bool = False
     flat_start: str = "rigid"
     stability_check: bool | None = None
 
@@ -175,6 +181,7 @@ class SolverOptions:
         _check.choice(self.flat_start, "options.flat_start", ("rigid", "tangent"))
         _check.boolean(self.reuse_factorization, "options.reuse_factorization")
         _check.boolean(self.acceleration, "options.acceleration")
+        _check.boolean(self.arc_stop_instability, "options.arc_stop_instability")
         if self.stability_check is not None:
             _check.boolean(self.stability_check, "options.stability_check")
         if self.augmentation != "auto":
@@ -199,7 +206,7 @@ class SolverOptions:
 
     def has_arc_stop(self) -> bool:
         """Whether any arc-length stop criterion other than the default is given."""
-        return any(
+        return self.arc_stop_instability or any(
             v is not None
             for v in (
                 self.arc_stop_load_factor,
@@ -212,7 +219,7 @@ class SolverOptions:
         """The load factor arc length stops on (None: no load-factor stop)."""
         if self.arc_stop_load_factor is not None:
             return float(self.arc_stop_load_factor)
-        if self.arc_stop_displacement is None and self.arc_stop_limit_points is None:
+        if not self.has_arc_stop():
             return 1.0
         return None
 

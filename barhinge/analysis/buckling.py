@@ -36,7 +36,13 @@ from barhinge.kernels.geometry import (
 from barhinge.linalg.backends import SingularMatrixError, get_backend
 from barhinge.linalg.threads import threads_for_sparse
 
-__all__ = ["Buckling", "linear_buckling", "stiffness_parts", "geometric_stiffness"]
+__all__ = [
+    "Buckling",
+    "critical_between",
+    "linear_buckling",
+    "stiffness_parts",
+    "geometric_stiffness",
+]
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -205,6 +211,76 @@ def linear_buckling(
     modes[:, free] = vec[:, order].T
     modes /= np.abs(modes).max(axis=1, keepdims=True)
     return Buckling(factors=factors, modes=modes.reshape(-1, n, 3), X=X, prebuckling=U)
+
+
+#: free DOFs up to which :func:`critical_between` solves its pencil densely
+DENSE_PENCIL = 50
+
+
+@threads_for_sparse
+def critical_between(
+    model: Any,
+    fixed: np.ndarray,
+    X_a: np.ndarray,
+    X_b: np.ndarray,
+    lam_a: float,
+    lam_b: float,
+) -> float:
+    """Load factor at which stability is lost between two equilibrium states of a path.
+
+    The free tangent is interpolated linearly between a stable state ``X_a`` (load factor
+    ``lam_a``; its tangent positive definite) and the next state ``X_b`` (``lam_b``; its
+    tangent has a negative eigenvalue): ``K(alpha) = K_a + alpha (K_b - K_a)``. The first
+    ``alpha`` in (0, 1] at which ``K(alpha)`` is singular, the largest eigenvalue
+    ``1 / alpha`` of the pencil ``(-(K_b - K_a), K_a)``, gives ``lam_a + alpha (lam_b -
+    lam_a)``: exact where the tangent is linear in the load factor between the two states
+    (a perfect strut on its straight path), and within the bracket otherwise (across a limit
+    point the load factor is not linear in the state, so there only within it; the secant
+    estimate of a critical point by eigenanalysis at the last stable state, e.g.
+    Wriggers, Wagner & Miehe 1988, Comput. Methods Appl. Mech. Eng. 70:329).
+
+    Raises
+    ------
+    BucklingError
+        If ``K_a`` is not positive definite, or ``K_b`` is (no loss of stability between
+        them), or the eigensolver fails.
+    """
+    import scipy.sparse.linalg as spla
+
+    n = model.n_nodes
+    free = np.flatnonzero(~np.asarray(fixed, bool).ravel())
+    Ka = sp.csr_matrix(model.tangent(np.asarray(X_a, float).reshape(n, 3))[free][:, free])
+    Kb = sp.csr_matrix(model.tangent(np.asarray(X_b, float).reshape(n, 3))[free][:, free])
+    if len(free) <= DENSE_PENCIL:  # ARPACK needs k < N; a small pencil is solved densely
+        import scipy.linalg
+
+        try:
+            theta = scipy.linalg.eigh((Ka - Kb).toarray(), Ka.toarray(), eigvals_only=True)[-1:]
+        except np.linalg.LinAlgError as exc:
+            raise BucklingError(
+                "critical_between: the tangent at the first state is not positive definite"
+            ) from exc
+    else:
+        try:
+            lu = get_backend("auto").factorize(Ka)
+        except SingularMatrixError as exc:
+            raise BucklingError(
+                "critical_between: the tangent at the first state is singular"
+            ) from exc
+        Kinv = spla.LinearOperator(Ka.shape, matvec=lu.solve, dtype=float)
+        A = sp.csc_matrix(Ka - Kb)
+        try:
+            theta, _ = spla.eigsh(A, k=1, M=Ka, Minv=Kinv, which="LA", tol=1e-10)
+        except (spla.ArpackNoConvergence, spla.ArpackError, RuntimeError, ValueError) as exc:
+            raise BucklingError(f"critical_between: the eigensolver failed ({exc})") from exc
+    if not theta[0] > 1.0 - 1e-9:
+        raise BucklingError(
+            "critical_between: no loss of stability between the two states (the interpolated "
+            f"tangent stays positive definite; largest 1/alpha = {theta[0]:.6g}, or the first "
+            "state's tangent is not positive definite)"
+        )
+    alpha = min(1.0, 1.0 / float(theta[0]))
+    return float(lam_a + alpha * (lam_b - lam_a))
 
 
 def _hinge_dofs(model: Any) -> np.ndarray:

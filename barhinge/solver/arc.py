@@ -146,7 +146,7 @@ def displacement_stop(ctx: SolveContext) -> tuple[int, float] | None:
 def stop_text(ctx: SolveContext, lam_stop: float | None, disp: tuple[int, float] | None) -> str:
     """What the run was asked to reach, for the step-cap message."""
     o = ctx.opts
-    if lam_stop is not None and disp is None and o.arc_stop_limit_points is None:
+    if lam_stop is not None and disp is None and not o.has_arc_stop():
         return f"of {lam_stop:g}"
     parts = [f"load factor {lam_stop:g}"] if lam_stop is not None else []
     spec = o.arc_stop_displacement
@@ -154,4 +154,6 @@ def stop_text(ctx: SolveContext, lam_stop: float | None, disp: tuple[int, float]
         parts.append(f"displacement {spec['axis']} = {spec['value']:g} of node {spec['node']}")
     if o.arc_stop_limit_points is not None:
         parts.append(f"{o.arc_stop_limit_points} limit point(s)")
+    if o.arc_stop_instability:
+        parts.append("a loss of stability")
     return "before reaching " + " or ".join(parts)

@@ -59,7 +59,9 @@ def run_arc_length(d: ArcDriver, progress: Progress | None) -> FoldPath:
     criterion is met (``options.arc_stop_*``; by default the load factor 1). The
     increment that passes a load-factor or displacement stop is replaced by a correction
     onto exactly that value (from the state before it, else back from the state past
-    it); a limit-point stop ends at the first state past the last limit point counted.
+    it); a limit-point stop ends at the first state past the last limit point counted, an
+    instability stop at the first state whose tangent has more negative eigenvalues than
+    the starting state's.
     Raises ConvergenceError when an increment fails after its cut-backs, when the step
     cap comes first, or when a landing fails: a path that did not reach its stop is
     never returned as converged."""
@@ -91,6 +93,9 @@ def run_arc_length(d: ArcDriver, progress: Progress | None) -> FoldPath:
             d.records[-1].neg = d.system.tangent_negative_eigenvalues()
         except SingularMatrixError:
             factored = False  # the attempt raises its own failure
+        if o.arc_stop_instability and _lost_stability(d.records[0].neg, d.records[-1].neg):
+            stop = {"criterion": "instability", "value": float(st.lam)}
+            break
         scale = dl0
         last: IncrementFailed | None = None
         for _cut in range(o.max_cutbacks + 1):
@@ -123,7 +128,8 @@ def run_arc_length(d: ArcDriver, progress: Progress | None) -> FoldPath:
         d.record(st, e_new, len(res) + 1, res)
         if progress is not None:
             progress(min(max(int(st.lam * steps), 0), steps), steps, st.lam)
-    d.records[-1].neg = d.inertia.tangent_inertia(st, e_new if n else e, exact=True)
+    if stop is None or stop["criterion"] != "instability":  # else known, exact, at this state
+        d.records[-1].neg = d.inertia.tangent_inertia(st, e_new if n else e, exact=True)
     if stop is None:
         msg = (
             f"arc length stopped at its step cap (max_arc_steps = {max_steps}) at load "
@@ -136,6 +142,12 @@ def run_arc_length(d: ArcDriver, progress: Progress | None) -> FoldPath:
     path = d.path()
     path.meta["arc_stop"] = stop
     return path
+
+
+def _lost_stability(start: int | None, now: int | None) -> bool:
+    """Whether a state with ``now`` negative eigenvalues of its tangent has lost stability
+    against the starting state's ``start`` (unknown counts: no)."""
+    return start is not None and now is not None and now > start
 
 
 def _arc_stop(

@@ -616,19 +616,12 @@ def stability(
     """Stability of one roof under the design load (uniform load plus self-weight).
 
     ``buckling_factor``: the first linear buckling factor of the stress-free folded state
-    (:func:`barhinge.analysis.buckling.linear_buckling`; NaN when there is none).
-    ``limit_load_factor``: the nonlinear check, arc length (MGDCM) from the unloaded state
-    that stops at the design load (load factor 1) or at the first limit point, whichever
-    comes first; the load factor of that limit point, or None when the roof carries the
-    design load without one. ``deflection_nonlinear``: the largest deflection at the end of
-    that path (at load factor 1 when it is reached), m. ``instability_load_factor``: the
-    lowest load factor on that path at which the roof is no longer stable, a limit point or
-    the first state whose tangent has a negative eigenvalue (a bifurcation), or None.
-    ``events``: the solver's stability events on the path."""
+    (:func:`barhinge.analysis.buckling.linear_buckling`; NaN when there is none); the other
+    keys are those of :func:`nonlinear_check` on the one-facet model."""
     import barhinge as bh
     from barhinge.analysis.buckling import linear_buckling
     from barhinge.errors import BarhingeError
-    from barhinge.scene import Scene, self_weight
+    from barhinge.scene import self_weight
 
     cp, flat_xy, crease = folded(family, state, **override)
     model = bh.BarHingeModel.from_pattern(cp, scheme, material())
@@ -640,24 +633,82 @@ def stability(
         lam_b = float(linear_buckling(model, P, S, n_modes=1).factors[0])
     except BarhingeError:
         lam_b = float("nan")
-    scene = Scene(model, supports=S, loads=P, control="arc_length", steps=steps,
+    return {"buckling_factor": lam_b, **nonlinear_check(model, S, P, steps)}
+
+
+def nonlinear_check(
+    model,
+    fixed: np.ndarray,
+    P: np.ndarray,
+    steps: int = 10,
+    stop_at_instability: bool = False,
+    keep_path: bool = False,
+) -> dict[str, Any]:
+    """The nonlinear check of a roof model under its design load ``P`` (N per node).
+
+    Arc length (MGDCM) from the unloaded state that stops at the design load (load factor 1)
+    or at the first limit point, whichever comes first, and with ``stop_at_instability`` at
+    the first state that has lost stability (``arc_stop_instability``); ``steps`` sets the
+    first increment (1 / steps of the load).
+
+    Returns
+    -------
+    dict
+        ``limit_load_factor``: the load factor of that limit point, or None when the roof
+        carries the design load without one. ``instability_load_factor``: the lowest load
+        factor on the path at which the roof is no longer stable, a limit point or the first
+        state whose tangent has a negative eigenvalue (a bifurcation), or None.
+        ``instability_bracket``: the load factors of the last stable state and of the first
+        one with a negative eigenvalue, and ``instability_estimate`` the load factor where
+        the tangent interpolated between them turns singular
+        (:func:`barhinge.analysis.buckling.critical_between`; None, with the reason in
+        ``instability_estimate_error``, where it cannot be found).
+        ``deflection_nonlinear``: the largest deflection at the end of the path (at load
+        factor 1 when it is reached), m. ``stop``: the criterion that ended the path.
+        ``load_factor_reached``: the path's largest load factor. ``events``: the solver's
+        stability events. ``states``, ``iterations``: the path's states and Newton
+        iterations. ``path``: the FoldPath itself, with ``keep_path``.
+    """
+    import barhinge as bh
+    from barhinge.scene import Scene
+
+    scene = Scene(model, supports=fixed, loads=P, control="arc_length", steps=steps,
                   options={"arc_stop_load_factor": 1.0, "arc_stop_limit_points": 1,
+                           "arc_stop_instability": stop_at_instability,
                            "max_arc_steps": 40 * steps})  # fmt: skip
     path = bh.solve(scene)
     stop = path.meta["arc_stop"]["criterion"]
     lam = np.asarray(path.load_factor)
     U = np.asarray(path.X[-1]) - np.asarray(path.X[0])
-    neg = [n for n in path.meta["negative_eigenvalues"]]
+    neg = list(path.meta["negative_eigenvalues"])
     first_neg = next((k for k, n in enumerate(neg) if n is not None and n > 0), None)
     limit = float(lam.max()) if stop == "limit_points" else None
     unstable = [v for v in (limit, None if first_neg is None else float(lam[first_neg])) if v]
-    return {
-        "buckling_factor": lam_b,
+    bracket, estimate, why = None, None, ""
+    if first_neg is not None and first_neg > 0:
+        from barhinge.analysis.buckling import critical_between
+        from barhinge.errors import BucklingError
+
+        k = first_neg
+        bracket = [float(lam[k - 1]), float(lam[k])]
+        try:
+            estimate = critical_between(model, fixed, path.X[k - 1], path.X[k], *bracket)
+        except BucklingError as exc:
+            why = str(exc).splitlines()[0]
+    out = {
         "limit_load_factor": limit,
         "instability_load_factor": min(unstable) if unstable else None,
+        "instability_bracket": bracket,
+        "instability_estimate": estimate,
+        "instability_estimate_error": why,
         "deflection_nonlinear": float(np.max(-U[:, 2])),
+        "load_factor_reached": float(lam.max()),
+        "stop": stop,
         "events": list(path.meta.get("events", [])),
+        "states": len(lam),
+        "iterations": int(path.meta["newton"]["total_iterations"]),
     }
+    return {**out, "path": path} if keep_path else out
 
 
 # ------------------------------------------------------------------------------ beam check

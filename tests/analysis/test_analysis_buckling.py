@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import barhinge as bh
-from barhinge.analysis.buckling import linear_buckling, stiffness_parts
+from barhinge.analysis.buckling import critical_between, linear_buckling, stiffness_parts
 from barhinge.errors import BucklingError
 from barhinge.pattern.crease import CreasePattern
 
@@ -73,6 +73,39 @@ def test_strut_of_rigid_links_buckles_at_the_closed_form(n):
     w = res.modes[0, : n + 1, 2]
     shape = np.sin(np.pi * x / (n * ell))
     np.testing.assert_allclose(w / w[np.argmax(np.abs(w))], shape / shape.max(), atol=1e-5)
+
+
+def test_arc_length_stops_where_the_strut_bifurcates():
+    """The straight strut of rigid links (above) loaded along its axis by arc length with
+    ``arc_stop_instability``: the path is the fundamental one (no lateral deflection), and
+    it ends at the first state whose tangent has a negative eigenvalue, the first past the
+    closed-form critical load ``P_1 = (4 k / l) sin^2(pi / (2 n))``."""
+    from barhinge.scene import Scene
+
+    n, ell, k = 5, 1.0, 2.0
+    m, S, P = _strip(n, ell=ell, k=k)
+    p1 = 4 * k / ell * np.sin(np.pi / (2 * n)) ** 2
+    opts = {"arc_stop_instability": True, "arc_stop_load_factor": 3.0, "max_arc_steps": 200}
+    path = bh.solve(Scene(m, supports=S, loads=P, control="arc_length", steps=20, options=opts))
+    lam = np.asarray(path.load_factor)
+    assert path.meta["arc_stop"]["criterion"] == "instability"
+    assert lam[-2] < p1 <= lam[-1] < p1 + 0.2
+    assert path.meta["negative_eigenvalues"][-1] == 1
+    assert np.abs(np.asarray(path.X)[:, :, 2]).max() < 1e-9  # still straight
+    # the tangent is linear in the load on the straight path: the interpolation is exact
+    X = np.asarray(path.X)
+    crit = critical_between(m, S, X[-2], X[-1], lam[-2], lam[-1])
+    assert crit == pytest.approx(p1, rel=1e-5)
+
+
+def test_critical_between_two_stable_states_is_a_named_error():
+    from barhinge.scene import Scene
+
+    m, S, P = _strip(5)
+    path = bh.solve(Scene(m, supports=S, loads=0.5 * P, control="load", steps=2))
+    X = np.asarray(path.X)  # below the critical load 0.764: both states stable
+    with pytest.raises(BucklingError, match="no loss of stability between the two states"):
+        critical_between(m, S, X[0], X[-1], 0.0, 0.5)
 
 
 def _plate_buckling_ratio(m: int) -> float:

@@ -1,4 +1,5 @@
-"""Arc-length stop criteria: a load factor, a displacement component, a number of limit points.
+"""Arc-length stop criteria: a load factor, a displacement component, a number of limit points,
+the first loss of stability.
 
 Reference: the von Mises two-bar truss of ``barhinge.verify`` (half span a = 1, rise h = 0.3,
 EA = 1000, Green-strain bars). With Green strain ``eps = (L^2 - L0^2) / (2 L0^2)`` and the
@@ -79,6 +80,37 @@ def test_limit_point_stop_ends_just_past_the_load_maximum():
     assert np.all(np.diff(lam[:-1]) > 0)  # and turned once, at the end
     assert lam.max() * FACTOR == pytest.approx(1.0, rel=2e-3)  # the maximum is P_max
     assert p.X[-1, apex, 2] < H / math.sqrt(3) < p.X[-3, apex, 2]
+
+
+def test_instability_stop_ends_at_the_first_state_past_the_load_maximum():
+    """Past ``P_max`` the apex snaps: the first state whose tangent has a negative eigenvalue
+    is the first one beyond ``z = h / sqrt(3)``, and the path ends there."""
+    sc, apex = scene(arc_stop_instability=True)
+    p = bh.solve(sc)
+    assert p.converged and p.meta["arc_stop"]["criterion"] == "instability"
+    assert p.meta["arc_stop"]["value"] == p.load_factor[-1]
+    z = p.X[:, apex, 2]
+    assert z[-1] < H / math.sqrt(3) < z[-2]
+    neg = p.meta["negative_eigenvalues"]
+    assert neg[-1] > 0 and all(n == 0 for n in neg[:-1])
+    # every state on the closed-form curve, the one past the maximum too
+    np.testing.assert_allclose(p.load_factor * FACTOR * P_MAX, p_closed_form(z), atol=1e-8)
+    # the tangent interpolated between the last two states: a load factor inside the
+    # bracket, below the closed-form maximum 1 / FACTOR (across a limit point the load
+    # factor is not linear in the state, so no closer than that)
+    from barhinge.analysis.buckling import critical_between
+
+    model, S, _ = von_mises_model()
+    lam, exact = p.load_factor, 1.0 / FACTOR
+    crit = critical_between(model, S, p.X[-2], p.X[-1], lam[-2], lam[-1])
+    assert min(lam[-2], lam[-1]) <= crit <= exact
+
+
+def test_instability_stop_alone_replaces_the_default_load_factor():
+    o = SolverOptions(arc_stop_instability=True)
+    assert o.has_arc_stop() and o.arc_stop_lambda() is None
+    with pytest.raises(ConfigError, match="arc_stop_instability"):
+        SolverOptions(arc_stop_instability=1)
 
 
 def test_first_criterion_met_wins():

@@ -82,9 +82,85 @@ def test_ranking_states_every_roof_once(study) -> None:
     for r in study.RESULTS:  # the quick roofs are no baselines
         label = f"{r['family']} {r['state']:g}:"
         assert text.count(label) == 1
+        assert "linear buckling factor" in text.split(label)[1].splitlines()[0]
         ok, why = study.stable(r, None)
-        assert ok == (r["buckling_factor"] > 1.0)
-        assert ok or "linear buckling factor" in why
+        inst, row = study.nonlinear_verdict(r)
+        assert row is not None and row["m"] == study.NONLINEAR_LEVELS[-1]
+        assert ok == (inst is None)
+        assert ok or f"unstable at load factor {inst:.3f} on the nonlinear path" in why
+
+
+def test_without_the_refined_check_the_one_facet_path_and_buckling_decide(study) -> None:
+    r = dict(study.RESULTS[0], nonlinear=[], buckling_factor=1.5)
+    assert study.stable(r, {"instability_load_factor": ""}) == (True, "")
+    ok, why = study.stable(r, {"instability_load_factor": "0.4"})
+    assert not ok and "0.400 on the one-facet nonlinear path" in why
+    ok, why = study.stable(dict(r, buckling_factor=0.5), None)
+    assert not ok and why == "linear buckling factor 0.500"
+
+
+def test_nonlinear_check_runs_at_its_levels_and_ends_on_a_criterion(study) -> None:
+    """Every quick roof is checked at ``NONLINEAR_LEVELS``; a path that keeps its stability
+    ends at load factor 1, one that loses it ends there (``arc_stop_instability``)."""
+    for r in study.RESULTS:
+        rows = r["nonlinear"]
+        assert [x["m"] for x in rows] == list(study.NONLINEAR_LEVELS)
+        for x in rows:
+            assert not x["error"]
+            if x["instability_load_factor"] is None:
+                assert x["stop"] == "load_factor" and x["load_factor_reached"] == 1.0
+            else:
+                assert x["stop"] in ("instability", "limit_points")
+                assert 0.0 < x["instability_load_factor"] <= x["load_factor_reached"] < 1.0
+    table = study.nonlinear_table(study.RESULTS, {})
+    assert table.count("\n") == len(study.RESULTS) + 1
+    assert "7. **Nonlinear check on refined panels.**" in study.nonlinear_finding(study.RESULTS, {})
+
+
+@pytest.mark.parametrize(("family", "state"), [("pleats", 90.0), ("yoshimura", 20.0)])
+def test_nonlinear_verdict_against_a_dense_eigensolver(study, family, state) -> None:
+    """The solver's verdict (the inertia of its sparse LDL^T factor) against the lowest
+    eigenvalue of the free tangent from a dense symmetric eigensolver (LAPACK, scipy.linalg.eigh)
+    at every state of the path, m = 2: positive at every state the path calls stable, negative
+    at the state where it stops for a loss of stability. The pleats carry the design load
+    although their linear buckling factor is below 1: their linear response deflects several
+    times the nonlinear one (a soft mode that stiffens as it deflects), which the linear
+    estimate extrapolates from."""
+    import numpy as np
+    import scipy.linalg
+
+    roofs = study.roofs
+    cp, flat_xy, _ = roofs.folded(family, state)
+    sv, se = roofs.support_lines(cp, flat_xy, roofs.FAMILIES[family]["axis"])
+    row = study.nonlinear_level(cp, sv, se, 2, keep_path=True)
+    path = row["path"]
+    model, S, _ = roofs.subdivided_roof(cp, sv, se, 2, study.RULE)
+    free = ~S.ravel()
+
+    def lowest(X) -> float:
+        K = model.tangent(np.asarray(X)).toarray()[np.ix_(free, free)]
+        return float(scipy.linalg.eigh(K, eigvals_only=True, subset_by_index=[0, 0])[0])
+
+    low = [lowest(X) for X in path.X]
+    if row["instability_load_factor"] is None:
+        assert all(v > 0 for v in low)
+        assert low[-1] > 2 * low[0]  # it stiffens along the path
+        assert path.load_factor[-1] == pytest.approx(1.0, abs=1e-12)
+        lb = study.level(cp, sv, se, 2)["buckling_factor"]
+        assert lb < 1.0  # the linear estimate says otherwise
+        assert row["deflection_linear"] > 3 * row["deflection_nonlinear"]
+    else:
+        assert all(v > 0 for v in low[:-1]) and low[-1] < 0
+        assert path.load_factor[-1] == pytest.approx(row["instability_load_factor"])
+        # the interpolated critical load factor: the dense tangent interpolated there is
+        # singular (its lowest eigenvalue zero against the tangent's scale)
+        lo, hi = row["instability_bracket"]
+        assert lo < row["instability_estimate"] <= hi
+        alpha = (row["instability_estimate"] - lo) / (hi - lo)
+        Ka = model.tangent(np.asarray(path.X[-2])).toarray()[np.ix_(free, free)]
+        Kb = model.tangent(np.asarray(path.X[-1])).toarray()[np.ix_(free, free)]
+        ev = scipy.linalg.eigh(Ka + alpha * (Kb - Ka), eigvals_only=True)
+        assert abs(ev[0]) < 1e-8 * ev[-1]
 
 
 def test_cell_membrane_error_is_the_worst_face_of_the_roof(study) -> None:
