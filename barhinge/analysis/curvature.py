@@ -34,6 +34,7 @@ __all__ = [
     "Curvature",
     "QuadraticFit",
     "angle_defect",
+    "boundary_nodes",
     "corner_angles",
     "fit_quadratic",
     "gaussian_curvature",
@@ -215,16 +216,19 @@ def corner_angles(X: np.ndarray, triangles: np.ndarray) -> np.ndarray:
 _NEXT, _PREV = np.array([1, 2, 0]), np.array([2, 0, 1])
 
 
-def mixed_voronoi_area(X: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+def mixed_voronoi_area(
+    X: np.ndarray, triangles: np.ndarray, angles: np.ndarray | None = None
+) -> np.ndarray:
     """(n_nodes,) float: mixed Voronoi area of every node (Meyer et al. 2003, Fig. 4).
 
     Non-obtuse triangle: Voronoi region ``(|PR|^2 cot Q + |PQ|^2 cot R) / 8`` for corner P;
     obtuse triangle: half its area to the obtuse corner, a quarter to each other corner. The
-    areas of all nodes sum to the area of the mesh.
+    areas of all nodes sum to the area of the mesh. ``angles``: the triangles'
+    :func:`corner_angles` at ``X``, where the caller has them.
     """
     X = np.asarray(X, float)
     T = np.asarray(triangles, np.int64)
-    ang = corner_angles(X, T)
+    ang = corner_angles(X, T) if angles is None else angles
     P = X[T]
     area = 0.5 * np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1)
     # squared length of the side opposite each corner c: between corners c+1 and c+2
@@ -240,7 +244,7 @@ def mixed_voronoi_area(X: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     return np.bincount(T.ravel(), weights=A.ravel(), minlength=len(X))
 
 
-def _boundary_nodes(triangles: np.ndarray, n_nodes: int) -> np.ndarray:
+def boundary_nodes(triangles: np.ndarray, n_nodes: int) -> np.ndarray:
     """(n_nodes,) bool: nodes on an edge used by exactly one triangle."""
     T = np.asarray(triangles, np.int64)
     a = T.ravel()
@@ -254,19 +258,27 @@ def _boundary_nodes(triangles: np.ndarray, n_nodes: int) -> np.ndarray:
     return flag
 
 
-def angle_defect(X: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+def angle_defect(
+    X: np.ndarray,
+    triangles: np.ndarray,
+    angles: np.ndarray | None = None,
+    boundary: np.ndarray | None = None,
+) -> np.ndarray:
     """(n_nodes,) float radians: ``2 pi - sum of corner angles`` at interior nodes.
 
     NaN at boundary nodes and at nodes used by no triangle. For a closed triangulated surface
     of genus 0 the defects sum to ``4 pi`` (Descartes' theorem, discrete Gauss-Bonnet).
+    ``angles`` (the triangles' :func:`corner_angles` at ``X``) and ``boundary`` (their
+    :func:`boundary_nodes`, which no state changes) are computed when not given.
     """
     X = np.asarray(X, float)
     T = np.asarray(triangles, np.int64)
     n = len(X)
-    total = np.bincount(T.ravel(), weights=corner_angles(X, T).ravel(), minlength=n)
+    ang = corner_angles(X, T) if angles is None else angles
+    total = np.bincount(T.ravel(), weights=ang.ravel(), minlength=n)
     d = 2 * np.pi - total
     used = np.bincount(T.ravel(), minlength=n) > 0
-    d[~used | _boundary_nodes(T, n)] = np.nan
+    d[~used | (boundary_nodes(T, n) if boundary is None else boundary)] = np.nan
     return d
 
 
@@ -435,8 +447,9 @@ def gaussian_curvature(
         T = np.asarray(triangles, np.int64)
         if T.size and T.max() >= len(X):
             raise ConfigError(f"triangles reference node {T.max()}, but X has {len(X)} nodes")
-        defect = angle_defect(X, T)
-        area = mixed_voronoi_area(X, T)
+        ang = corner_angles(X, T)
+        defect = angle_defect(X, T, angles=ang)
+        area = mixed_voronoi_area(X, T, angles=ang)
     return Curvature(
         points=P,
         k1=fits["k1"],

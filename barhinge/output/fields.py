@@ -22,7 +22,13 @@ from typing import Any
 
 import numpy as np
 
-from barhinge.analysis.curvature import angle_defect, mixed_voronoi_area, pattern_triangles
+from barhinge.analysis.curvature import (
+    angle_defect,
+    boundary_nodes,
+    corner_angles,
+    mixed_voronoi_area,
+    pattern_triangles,
+)
 from barhinge.analysis.forces import bar_axial_forces, panel_membrane_resultants
 from barhinge.errors import ConfigError
 from barhinge.results import FoldPath
@@ -96,8 +102,28 @@ def _model_topology(model: Any) -> dict[str, np.ndarray]:
     ok = key_line[order[at]] == key_h
     on_edge = np.isin(key_line, _pair_index(model.pattern.edges, n))
     topo = {"tri": tri, "wing_tri": wing_tri, "lines": lines, "fold": fold,
-            "line_of_fold": order[at[ok]], "fold_hinge": hf[ok], "on_edge": on_edge}  # fmt: skip
+            "line_of_fold": order[at[ok]], "fold_hinge": hf[ok], "on_edge": on_edge,
+            "boundary": boundary_nodes(tri, n)}  # fmt: skip
     _TOPOLOGY[model] = topo
+    return topo
+
+
+def _pattern_topology(cp: Any, n: int) -> dict[str, np.ndarray]:
+    """What :func:`state_data` needs of a pattern's mesh (fan triangles, edges, creases,
+    reference lengths, boundary nodes of ``n`` nodes), computed once per pattern (patterns
+    are frozen)."""
+    topo = _TOPOLOGY.get(cp)
+    if topo is not None and len(topo["boundary"]) == n:
+        return topo
+    tri = pattern_triangles(cp)
+    lines = np.asarray(cp.edges, np.int64)
+    crease = np.zeros(len(lines), bool)
+    crease[cp.crease_edges] = True
+    V = cp.vertices3d
+    topo = {"tri": tri, "lines": lines, "crease": crease,
+            "L0": np.linalg.norm(V[lines[:, 1]] - V[lines[:, 0]], axis=1),
+            "boundary": boundary_nodes(tri, n)}  # fmt: skip
+    _TOPOLOGY[cp] = topo
     return topo
 
 
@@ -221,17 +247,15 @@ def state_data(
         cp = pattern
         if n < cp.n_vertices:
             raise ConfigError(f"len(X) = {n}, but the pattern has {cp.n_vertices} vertices")
-        tri = pattern_triangles(cp)
-        lines = np.asarray(cp.edges, np.int64)
+        topo = _pattern_topology(cp, n)
+        tri, lines, crease = topo["tri"], topo["lines"], topo["crease"]
         if fold_angles_deg is None:
             fold_angles_deg = cp.replaced(
                 vertices=X[: cp.n_vertices], validate=False
             ).state_fold_angles()
         fold_ang = np.asarray(fold_angles_deg, float).copy()
-        crease = np.zeros(len(lines), bool)
-        crease[cp.crease_edges] = True
         fold_ang[~crease] = np.nan
-        L0 = np.linalg.norm(cp.vertices3d[lines[:, 1]] - cp.vertices3d[lines[:, 0]], axis=1)
+        L0 = topo["L0"]
         L = np.linalg.norm(X[lines[:, 1]] - X[lines[:, 0]], axis=1)
         strain_line = (L - L0) / L0
         e_line = np.full(len(lines), np.nan)
@@ -242,9 +266,10 @@ def state_data(
         Xr = cp.vertices3d if X_ref is None else X_ref
     Xr = np.asarray(Xr, float)
     disp = X - Xr if Xr.shape == X.shape else np.zeros_like(X)
-    defect = angle_defect(X, tri)
+    ang = corner_angles(X, tri)
+    defect = angle_defect(X, tri, angles=ang, boundary=topo["boundary"])
     with np.errstate(divide="ignore", invalid="ignore"):
-        density = defect / mixed_voronoi_area(X, tri)
+        density = defect / mixed_voronoi_area(X, tri, angles=ang)
     nan_t = np.full(len(tri), np.nan)
     point_data = {"displacement": disp, "angle_defect": defect, "defect_density": density}
     if reactions is not None:

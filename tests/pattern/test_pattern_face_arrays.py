@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import barhinge as bh
-from barhinge.analysis.curvature import _boundary_nodes, pattern_triangles, reference_points
+from barhinge.analysis.curvature import boundary_nodes, pattern_triangles, reference_points
 from barhinge.pattern.crease import CreasePattern
 
 
@@ -65,4 +65,4 @@ def test_fan_triangles_tile_the_faces_and_find_the_boundary() -> None:
         assert tri_area.sum() == pytest.approx(sum(face_area), rel=1e-12)
         boundary = np.ones(cp.n_vertices, bool)
         boundary[list(cp.interior_vertices)] = False
-        np.testing.assert_array_equal(_boundary_nodes(T, cp.n_vertices), boundary)
+        np.testing.assert_array_equal(boundary_nodes(T, cp.n_vertices), boundary)
