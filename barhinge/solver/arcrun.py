@@ -205,17 +205,38 @@ def _land(
     d: ArcDriver, st: State, past: State, lam: float = 1.0
 ) -> tuple[State, Evaluation, list[float]]:
     """Correct onto load factor exactly ``lam`` by load control: from ``st`` (before
-    it), else from ``past`` (the arc-length state beyond it) back. Raises
-    ConvergenceError with the path up to ``st`` when both fail."""
+    it), else from ``past`` (the arc-length state beyond it) back, else from ``st`` in
+    load-controlled sub-steps (halved on failure, at most ``max_cutbacks`` times, doubled
+    after a success; for an increment that leapt far past ``lam``, as on a sheet that
+    stiffens by orders of magnitude as it deflects). Raises ConvergenceError with the path
+    up to ``st`` when all fail."""
     whys = []
     for start in (st, past):
         try:
             return d.increment(start, start.t, lam)
         except IncrementFailed as f:
             whys.append(f.why)
+    cur, h = st, 0.5 * (lam - st.lam)
+    res_all: list[float] = []
+    halvings, whys_sub = 0, ""
+    while halvings <= d.opts.max_cutbacks:
+        to = lam if abs(lam - cur.lam) <= abs(h) else cur.lam + h
+        try:
+            cur, e, res = d.increment(cur, cur.t, to)
+        except IncrementFailed as f:
+            h, halvings = 0.5 * h, halvings + 1
+            whys_sub = f.why
+            continue
+        res_all += res
+        if cur.lam == lam:
+            return cur, e, res_all
+        h *= 2.0
+    else:
+        whys.append(f"in sub-steps: {whys_sub}")
     msg = (
         f"arc length passed load factor {lam:g} (from {st.lam:.6g} to {past.lam:.6g}) "
-        f"but the correction onto {lam:g} failed ({whys[0]}; from the far side: {whys[1]})"
+        f"but the correction onto {lam:g} failed ({whys[0]}; from the far side: {whys[1]}; "
+        f"{whys[2]})"
     )
     raise ConvergenceError(
         msg, step=len(d.records), load_factor=st.lam, residuals=[],

@@ -174,3 +174,31 @@ def test_stops_read_from_a_toml_options_table():
     assert o.arc_stop_displacement == {"node": 2, "axis": "z", "value": -0.5}
     assert o.arc_stop_limit_points == 2 and o.arc_stop_lambda() is None
     assert SolverOptions().arc_stop_lambda() == 1.0
+
+
+def test_a_leap_far_past_the_stop_lands_in_sub_steps():
+    """A thin pinned square plate under a transverse load stiffens by orders of magnitude as
+    its membrane takes over: its first arc-length increment, sized on the flat plate's
+    bending, leaps to a load factor ~1e11 and the direct correction onto 1 fails from both
+    sides. The landing then goes from the state before in load-controlled sub-steps, and
+    ends on the state a load-controlled solve in 20 steps reaches (an independent path)."""
+    from barhinge.pattern.crease import CreasePattern
+    from barhinge.pattern.subdivide import subdivided
+
+    sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    cp = CreasePattern(sq, [[0, 1], [1, 2], [2, 3], [3, 0]], ["B"] * 4, faces=[[0, 1, 2, 3]])
+    model = bh.BarHingeModel.from_pattern(
+        subdivided(cp, 4)[0], "N5B8", bh.Material(E=70e9, nu=0.33, t=1e-4)
+    )
+    X = np.asarray(model.X0)
+    edge = np.isclose(X[:, :2], 0.0).any(axis=1) | np.isclose(X[:, :2], 1.0).any(axis=1)
+    S = np.zeros((model.n_nodes, 3), bool)
+    S[edge] = True
+    P = np.zeros((model.n_nodes, 3))
+    P[~edge, 2] = -1e3 / np.count_nonzero(~edge)  # 1 kN in all
+    arc = bh.solve(Scene(model, supports=S, loads=P, control="arc_length", steps=10))
+    assert arc.converged and arc.load_factor[-1] == 1.0
+    ref = bh.solve(Scene(model, supports=S, loads=P, control="load", steps=20))
+    w = -ref.X[-1][:, 2].min()
+    assert w > 100 * model.material.t  # deep in the membrane regime
+    np.testing.assert_allclose(arc.X[-1], ref.X[-1], atol=1e-8 * w)
