@@ -225,62 +225,72 @@ def critical_between(
     X_b: np.ndarray,
     lam_a: float,
     lam_b: float,
+    rtol: float = 1e-5,
 ) -> float:
     """Load factor at which stability is lost between two equilibrium states of a path.
 
     The free tangent is interpolated linearly between a stable state ``X_a`` (load factor
-    ``lam_a``; its tangent positive definite) and the next state ``X_b`` (``lam_b``; its
-    tangent has a negative eigenvalue): ``K(alpha) = K_a + alpha (K_b - K_a)``. The first
-    ``alpha`` in (0, 1] at which ``K(alpha)`` is singular, the largest eigenvalue
-    ``1 / alpha`` of the pencil ``(-(K_b - K_a), K_a)``, gives ``lam_a + alpha (lam_b -
-    lam_a)``: exact where the tangent is linear in the load factor between the two states
-    (a perfect strut on its straight path), and within the bracket otherwise (across a limit
-    point the load factor is not linear in the state, so there only within it; the secant
-    estimate of a critical point by eigenanalysis at the last stable state, e.g.
-    Wriggers, Wagner & Miehe 1988, Comput. Methods Appl. Mech. Eng. 70:329).
+    ``lam_a``) and the next state ``X_b`` (``lam_b``), whose tangent has more negative
+    eigenvalues: ``K(alpha) = K_a + alpha (K_b - K_a)``. The first ``alpha`` in (0, 1] at
+    which ``K(alpha)`` gains a negative eigenvalue gives ``lam_a + alpha (lam_b - lam_a)``:
+    exact where the tangent is linear in the load factor between the two states (a perfect
+    strut on its straight path), and within the bracket otherwise (across a limit point the
+    load factor is not linear in the state, so there only within it; the secant estimate of
+    a critical point at the last stable state, e.g. Wriggers, Wagner & Miehe 1988, Comput.
+    Methods Appl. Mech. Eng. 70:329). Small systems (up to ``DENSE_PENCIL`` free DOFs) solve
+    the pencil ``(K_a - K_b, K_a)`` densely; larger ones bisect ``alpha`` on the inertia of
+    the sparse LDL^T factor of ``K(alpha)`` (Sylvester's law) to ``rtol`` of the bracket.
 
     Raises
     ------
     BucklingError
-        If ``K_a`` is not positive definite, or ``K_b`` is (no loss of stability between
-        them), or the eigensolver fails.
+        If ``K_b`` has no more negative eigenvalues than ``K_a`` (no loss of stability
+        between them), or the factorisation reports no inertia.
     """
-    import scipy.sparse.linalg as spla
-
     n = model.n_nodes
     free = np.flatnonzero(~np.asarray(fixed, bool).ravel())
     Ka = sp.csr_matrix(model.tangent(np.asarray(X_a, float).reshape(n, 3))[free][:, free])
     Kb = sp.csr_matrix(model.tangent(np.asarray(X_b, float).reshape(n, 3))[free][:, free])
-    if len(free) <= DENSE_PENCIL:  # ARPACK needs k < N; a small pencil is solved densely
+    none = BucklingError(
+        "critical_between: no loss of stability between the two states (the second state's "
+        "tangent has no more negative eigenvalues than the first's)"
+    )
+    if len(free) <= DENSE_PENCIL:
         import scipy.linalg
 
-        try:
-            theta = scipy.linalg.eigh((Ka - Kb).toarray(), Ka.toarray(), eigvals_only=True)[-1:]
+        try:  # K(alpha) singular <=> (K_a - K_b) phi = (1 / alpha) K_a phi
+            theta = scipy.linalg.eigh((Ka - Kb).toarray(), Ka.toarray(), eigvals_only=True)[-1]
         except np.linalg.LinAlgError as exc:
             raise BucklingError(
                 "critical_between: the tangent at the first state is not positive definite"
             ) from exc
-    else:
+        if not theta > 1.0 - 1e-9:
+            raise none
+        return float(lam_a + min(1.0, 1.0 / float(theta)) * (lam_b - lam_a))
+    D = (Kb - Ka).tocsr()
+    backend = get_backend("auto")
+
+    def negative(alpha: float) -> int:
         try:
-            lu = get_backend("auto").factorize(Ka)
-        except SingularMatrixError as exc:
-            raise BucklingError(
-                "critical_between: the tangent at the first state is singular"
-            ) from exc
-        Kinv = spla.LinearOperator(Ka.shape, matvec=lu.solve, dtype=float)
-        A = sp.csc_matrix(Ka - Kb)
-        try:
-            theta, _ = spla.eigsh(A, k=1, M=Ka, Minv=Kinv, which="LA", tol=1e-10)
-        except (spla.ArpackNoConvergence, spla.ArpackError, RuntimeError, ValueError) as exc:
-            raise BucklingError(f"critical_between: the eigensolver failed ({exc})") from exc
-    if not theta[0] > 1.0 - 1e-9:
-        raise BucklingError(
-            "critical_between: no loss of stability between the two states (the interpolated "
-            f"tangent stays positive definite; largest 1/alpha = {theta[0]:.6g}, or the first "
-            "state's tangent is not positive definite)"
-        )
-    alpha = min(1.0, 1.0 / float(theta[0]))
-    return float(lam_a + alpha * (lam_b - lam_a))
+            count = backend.factorize((Ka + alpha * D).tocsr()).negative_pivots()
+        except SingularMatrixError:  # singular at alpha: count it as lost, from above
+            return n_a + 1
+        if count is None:
+            raise BucklingError("critical_between: the factorisation reports no inertia")
+        return int(count)
+
+    n_a = 0
+    n_a = negative(0.0)
+    if negative(1.0) <= n_a:
+        raise none
+    lo, hi = 0.0, 1.0
+    while hi - lo > rtol:
+        mid = 0.5 * (lo + hi)
+        if negative(mid) > n_a:
+            hi = mid
+        else:
+            lo = mid
+    return float(lam_a + 0.5 * (lo + hi) * (lam_b - lam_a))
 
 
 def _hinge_dofs(model: Any) -> np.ndarray:

@@ -75,11 +75,12 @@ def test_strut_of_rigid_links_buckles_at_the_closed_form(n):
     np.testing.assert_allclose(w / w[np.argmax(np.abs(w))], shape / shape.max(), atol=1e-5)
 
 
-def test_arc_length_stops_where_the_strut_bifurcates():
+def test_arc_length_stops_where_the_strut_bifurcates(monkeypatch):
     """The straight strut of rigid links (above) loaded along its axis by arc length with
     ``arc_stop_instability``: the path is the fundamental one (no lateral deflection), and
     it ends at the first state whose tangent has a negative eigenvalue, the first past the
     closed-form critical load ``P_1 = (4 k / l) sin^2(pi / (2 n))``."""
+    from barhinge.analysis import buckling
     from barhinge.scene import Scene
 
     n, ell, k = 5, 1.0, 2.0
@@ -94,8 +95,12 @@ def test_arc_length_stops_where_the_strut_bifurcates():
     assert np.abs(np.asarray(path.X)[:, :, 2]).max() < 1e-9  # still straight
     # the tangent is linear in the load on the straight path: the interpolation is exact
     X = np.asarray(path.X)
-    crit = critical_between(m, S, X[-2], X[-1], lam[-2], lam[-1])
+    crit = critical_between(m, S, X[-2], X[-1], lam[-2], lam[-1])  # dense pencil
     assert crit == pytest.approx(p1, rel=1e-5)
+    # the same by bisection on the inertia of the sparse factor (large systems)
+    monkeypatch.setattr(buckling, "DENSE_PENCIL", 0)
+    bisected = critical_between(m, S, X[-2], X[-1], lam[-2], lam[-1], rtol=1e-6)
+    assert bisected == pytest.approx(p1, rel=1e-5)
 
 
 def test_critical_between_two_stable_states_is_a_named_error():
