@@ -378,11 +378,14 @@ def table(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
 
 
 def critical(x: dict) -> float | None:
-    """A nonlinear check's load factor of the first loss of stability: the interpolated
-    estimate inside its bracket where there is one, else the first unstable state's; None
-    when the path carries the design load."""
+    """A nonlinear check's load factor of the first loss of stability: the load maximum
+    where the path stopped past a limit point, else the interpolated estimate inside its
+    bracket where there is one, else the first unstable state's; None when the path
+    carries the design load."""
     if x["instability_load_factor"] is None:
         return None
+    if x.get("stop") == "limit_points" and x.get("limit_load_factor") is not None:
+        return float(x["limit_load_factor"])
     est = x.get("instability_estimate")
     return float(est) if est is not None else float(x["instability_load_factor"])
 
@@ -440,6 +443,8 @@ def _inst(x: dict | None) -> str:
     crit = critical(x)
     if crit is None:
         return "stable to 1"
+    if x.get("stop") == "limit_points":
+        return f"{crit:.3f} (limit point)"
     b = x.get("instability_bracket")
     return f"{crit:.3f} ({b[0]:.3f}–{b[1]:.3f})" if b else f"{crit:.3f}"
 
@@ -591,6 +596,10 @@ def findings(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
     )
 
 
+#: a roof that loses stability within this fraction below the design load is marginal
+MARGINAL = 0.05
+
+
 def carried_all(results: list[dict]) -> list[dict]:
     """The roofs whose finest nonlinear check carries the design load."""
     return [
@@ -661,6 +670,14 @@ def nonlinear_finding(results: list[dict], coarse: dict[str, dict[str, str]]) ->
             " " + ", ".join(map(lab, flipped_m)) + f" lose stability at m = {NONLINEAR_LEVELS[-2]}"
             f" and not at m = {m}: for them the coarser level is outside the range where the"
             " verdict settles, and the finer level's verdict is the one given."
+        )
+    marginal = [r for r in lost if nonlinear_verdict(r)[0] >= 1.0 - MARGINAL]  # type: ignore[operator]
+    if marginal:
+        parts.append(
+            " "
+            + ", ".join(f"{lab(r)} ({nonlinear_verdict(r)[0]:.3f})" for r in marginal)
+            + f" lose stability within {100 * MARGINAL:g} % of the design load: marginal, a"
+            " verdict that a finer load increment or sub-panel level can turn."
         )
     carried = [r for r in checked if nonlinear_verdict(r)[0] is None]
     lba = [r for r in carried if not r["buckling_factor"] > 1.0]
@@ -841,8 +858,9 @@ def section(results: list[dict]) -> str:
             "Nonlinear check, one facet per panel (the comparison table) and refined: the load"
             " factor at which the path loses stability (a limit point, or the first state whose"
             " tangent has a negative eigenvalue), or *stable to 1*. On the refined panels the"
-            " path stops at the first unstable state; the load factor given is where the"
-            " tangent, interpolated between the last stable state and that one, turns singular"
+            " path stops at the first unstable state; the load factor given is the load maximum"
+            " at a limit point, else where the tangent, interpolated between the last stable"
+            " state and that one, turns singular"
             " (`barhinge.analysis.buckling.critical_between`), with the two states' load factors"
             " in brackets. Then the change between the refined levels, where the refined path"
             " ends and its largest deflection there.",

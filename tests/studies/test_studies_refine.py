@@ -242,3 +242,20 @@ def test_every_roof_has_its_shell_gap(study) -> None:
     text = study.table(study.RESULTS, {})
     assert "limit / shell − 1" in text
     assert "6. **Against the shell.**" in study.shell_finding(study.RESULTS)
+
+
+def test_critical_load_factor_of_a_check(study) -> None:
+    """Past a limit point the load maximum is where stability is lost (the first unstable
+    state lies below it, on the descending branch); at a bifurcation the interpolated
+    estimate inside the bracket; a path that carries the design load has none."""
+    base = {"limit_load_factor": None, "instability_load_factor": None, "stop": "load_factor",
+            "instability_estimate": None, "instability_bracket": None}  # fmt: skip
+    assert study.critical(base) is None
+    limit = dict(base, stop="limit_points", limit_load_factor=0.56, instability_load_factor=0.54,
+                 instability_bracket=[0.56, 0.54], instability_estimate=0.541)  # fmt: skip
+    assert study.critical(limit) == 0.56
+    assert study._inst(limit) == "0.560 (limit point)"
+    bif = dict(base, stop="instability", instability_load_factor=0.30,
+               instability_bracket=[0.28, 0.30], instability_estimate=0.295)  # fmt: skip
+    assert study.critical(bif) == 0.295
+    assert study._inst(bif) == "0.295 (0.280–0.300)"
