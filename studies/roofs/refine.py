@@ -58,6 +58,7 @@ ROOT = HERE.parents[1]
 DOC = ROOT / "docs" / "roofs.md"
 CSV_MAIN = ROOT / "docs" / "roofs.csv"
 CSV_OUT = ROOT / "docs" / "roofs_refined.csv"
+CSV_NONLINEAR = ROOT / "docs" / "roofs_refined_nonlinear.csv"
 START, END = "<!-- roofs-refined:start -->", "<!-- roofs-refined:end -->"
 
 #: refined when the stiffness changes by less than this between two levels (relative)
@@ -797,6 +798,29 @@ def write_csv(results: list[dict], path: Path) -> None:
                             for c in cols] + [last])  # fmt: skip
 
 
+def write_nonlinear_csv(results: list[dict], path: Path) -> None:
+    """One row per roof and nonlinear level: where the path stopped and why, the bracket
+    and the critical load factor (:func:`critical`), deflections (m), cost."""
+    cols = ["family", "state", "m", "n_dof", "stop", "critical_load_factor",
+            "bracket_low", "bracket_high", "load_factor_reached", "deflection_linear",
+            "deflection_nonlinear", "states", "iterations", "time_s", "error"]  # fmt: skip
+    with path.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(cols)
+        for r in results:
+            for x in r.get("nonlinear", []):
+                b = x.get("instability_bracket") or [None, None]
+                crit = None if x.get("error") else critical(x)
+                vals = {**x, "family": r["family"], "state": r["state"],
+                        "critical_load_factor": crit, "bracket_low": b[0], "bracket_high": b[1],
+                        "stop": x.get("stop", ""), "states": x.get("states", ""),
+                        "iterations": x.get("iterations", "")}  # fmt: skip
+                w.writerow(
+                    ["" if vals.get(c) is None else f"{vals[c]:.6g}" if isinstance(vals[c], float)
+                     else vals[c] for c in cols]
+                )  # fmt: skip
+
+
 def chart(results: list[dict], path: Path) -> None:
     """k / width and buckling factor against DOFs, one panel pair per family."""
     import matplotlib
@@ -863,7 +887,8 @@ def section(results: list[dict]) -> str:
             " state and that one, turns singular"
             " (`barhinge.analysis.buckling.critical_between`), with the two states' load factors"
             " in brackets. Then the change between the refined levels, where the refined path"
-            " ends and its largest deflection there.",
+            " ends and its largest deflection there (every level:"
+            " [roofs_refined_nonlinear.csv](roofs_refined_nonlinear.csv)).",
             "",
             nonlinear_table(results, coarse),
             "",
@@ -889,4 +914,5 @@ if MAIN:
         DOC.write_text(doc)
         chart(RESULTS, DOC.parent / "img" / "roofs_refined.png")
         write_csv(RESULTS, CSV_OUT)
-        print(f"wrote {DOC}, {CSV_OUT}")
+        write_nonlinear_csv(RESULTS, CSV_NONLINEAR)
+        print(f"wrote {DOC}, {CSV_OUT}, {CSV_NONLINEAR}")

@@ -259,3 +259,16 @@ def test_critical_load_factor_of_a_check(study) -> None:
                instability_bracket=[0.28, 0.30], instability_estimate=0.295)  # fmt: skip
     assert study.critical(bif) == 0.295
     assert study._inst(bif) == "0.295 (0.280–0.300)"
+
+
+def test_nonlinear_csv_has_every_level(study, tmp_path) -> None:
+    import csv
+
+    out = tmp_path / "nl.csv"
+    study.write_nonlinear_csv(study.RESULTS, out)
+    rows = list(csv.DictReader(out.open()))
+    assert len(rows) == sum(len(r["nonlinear"]) for r in study.RESULTS)
+    for row, x in zip(rows, (x for r in study.RESULTS for x in r["nonlinear"]), strict=True):
+        assert int(row["m"]) == x["m"] and row["stop"] == x["stop"]
+        crit = study.critical(x)
+        assert (row["critical_load_factor"] == "") == (crit is None)
