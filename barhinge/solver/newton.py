@@ -248,8 +248,13 @@ class _Driver:
         return path
 
     def fail(self, step: int, lam: float, why: str, res: list[float]) -> ConvergenceError:
+        where = (
+            f"arc-length increment {step}"
+            if self.scene.control == "arc_length"
+            else f"step {step} of {self.scene.steps}"
+        )
         msg = (
-            f"step {step} of {self.scene.steps} did not converge at load factor {lam:.6g} "
+            f"{where} did not converge at load factor {lam:.6g} "
             f"after {self.opts.max_cutbacks} cut-backs ({why})"
         )
         return ConvergenceError(

@@ -601,6 +601,14 @@ def findings(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
 MARGINAL = 0.05
 
 
+def _failed_at(x: dict) -> str:
+    """The load factor a failed check's message names ("at load factor 0.77"), or "?"."""
+    import re
+
+    found = re.search(r"at load factor ([-+0-9.eE]+)", x.get("error", ""))
+    return f"{float(found.group(1)):.3f}" if found else "?"
+
+
 def carried_all(results: list[dict]) -> list[dict]:
     """The roofs whose finest nonlinear check carries the design load."""
     return [
@@ -699,6 +707,18 @@ def nonlinear_finding(results: list[dict], coarse: dict[str, dict[str, str]]) ->
         parts.append(
             " The check failed on " + ", ".join(map(lab, failed)) + " (named in the table);"
             " their verdict is the one-facet path's."
+        )
+    fine_failed = [
+        r for r in checked if r["nonlinear"][-1].get("error") and r["nonlinear"][-1]["m"] == m
+    ]
+    if fine_failed:
+        parts.append(
+            f" At m = {m} the check failed on "
+            + ", ".join(
+                f"{lab(r)} (at load factor {_failed_at(r['nonlinear'][-1])})" for r in fine_failed
+            )
+            + " with no loss of stability before (named in the table); their verdict is the"
+            f" one at m = {NONLINEAR_LEVELS[-2]}."
         )
     return "".join(parts)
 
