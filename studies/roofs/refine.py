@@ -503,9 +503,8 @@ def ranking(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
             _, row = nonlinear_verdict(r)
             if row is not None and not r["buckling_factor"] > 1.0:
                 lb += (
-                    f" (below 1: its linear pre-buckling state deflects "
-                    f"{row['deflection_linear'] / row['deflection_nonlinear']:.1f} × the "
-                    "nonlinear one at the design load)"
+                    " (below 1: imperfection-sensitive; linear / nonlinear deflection "
+                    f"{row['deflection_linear'] / row['deflection_nonlinear']:.1f})"
                 )
             ok.append(f"{len(ok) + 1}. {label}: {k}, {lb}")
         else:
@@ -513,12 +512,13 @@ def ranking(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
     return "\n".join(
         [
             "Stiffest refined roofs that carry the design load: on the nonlinear path of the"
-            f" refined panels (m = {NONLINEAR_LEVELS[-1]}, the perfect geometry, imperfections"
-            " not assessed) the roof reaches load factor 1 with no limit point and no state"
-            " whose tangent has a negative eigenvalue; the flat sheet, a baseline, is left out."
-            " The linear buckling factor is given beside; where it is below 1 the linear"
-            " pre-buckling state is far from the nonlinear one, and the linear estimate does"
-            " not hold (finding 7):",
+            f" refined panels (m = {NONLINEAR_LEVELS[-1]}) the roof reaches load factor 1 with"
+            " no limit point and no state whose tangent has a negative eigenvalue; the flat"
+            " sheet, a baseline, is left out. This is the perfect geometry: where the linear"
+            " buckling factor beside it is below 1 (given with the ratio of the linear to the"
+            " nonlinear deflection at the design load), it points to a critical point near the"
+            " path, so that roof is imperfection-sensitive and needs an imperfection study"
+            " before it is designed with (finding 7):",
             "",
             *(ok or ["(none)"]),
             "",
@@ -685,7 +685,8 @@ def nonlinear_finding(results: list[dict], coarse: dict[str, dict[str, str]]) ->
         parts.append(
             " "
             + ", ".join(f"{lab(r)} ({nonlinear_verdict(r)[0]:.3f})" for r in marginal)
-            + f" lose stability within {100 * MARGINAL:g} % of the design load: marginal, a"
+            + (" loses" if len(marginal) == 1 else " lose")
+            + f" stability within {100 * MARGINAL:g} % of the design load: marginal, a"
             " verdict that a finer load increment or sub-panel level can turn."
         )
     carried = [r for r in checked if nonlinear_verdict(r)[0] is None]
@@ -700,8 +701,10 @@ def nonlinear_finding(results: list[dict], coarse: dict[str, dict[str, str]]) ->
             " linear estimate takes the pre-buckling state as linear and its stress as"
             " proportional to the load; the nonlinear path follows the deforming roof and"
             " counts the negative eigenvalues of its tangent at every state (checked against a"
-            " dense eigensolver in `tests/studies/test_studies_refine.py`), so its verdict"
-            " stands, for the perfect geometry."
+            " dense eigensolver in `tests/studies/test_studies_refine.py`). Where the two"
+            " disagree, the perfect roof carries the load on its path, but the linear estimate"
+            " points to a critical point nearby: an imperfect roof may not carry it, and the"
+            " ranking marks these roofs imperfection-sensitive."
         )
     if failed:
         parts.append(
@@ -717,8 +720,9 @@ def nonlinear_finding(results: list[dict], coarse: dict[str, dict[str, str]]) ->
             + ", ".join(
                 f"{lab(r)} (at load factor {_failed_at(r['nonlinear'][-1])})" for r in fine_failed
             )
-            + " with no loss of stability before (named in the table); their verdict is the"
-            f" one at m = {NONLINEAR_LEVELS[-2]}."
+            + " with no loss of stability before (named in the table); "
+            + ("its" if len(fine_failed) == 1 else "their")
+            + f" verdict is the one at m = {NONLINEAR_LEVELS[-2]}."
         )
     return "".join(parts)
 
