@@ -88,6 +88,12 @@ def test_ranking_states_every_roof_once(study) -> None:
         assert row is not None and row["m"] == study.NONLINEAR_LEVELS[-1]
         assert ok == (inst is None)
         assert ok or f"unstable at load factor {inst:.3f} on the nonlinear path" in why
+        # carried by the perfect roof, but the linear estimate below 1: marked
+        line = text.split(label)[1].splitlines()[0]
+        assert ("imperfection-sensitive" in line) == (ok and not r["buckling_factor"] > 1.0)
+    pleats = next(r for r in study.RESULTS if r["family"] == "pleats")
+    assert "imperfection-sensitive" in text.split("pleats 90:")[1].splitlines()[0]
+    assert pleats["buckling_factor"] < 1.0
 
 
 def test_without_the_refined_check_the_one_facet_path_and_buckling_decide(study) -> None:
