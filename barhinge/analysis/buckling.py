@@ -279,7 +279,7 @@ def critical_between(
             raise BucklingError("critical_between: the factorisation reports no inertia")
         return int(count)
 
-    n_a = 0
+    n_a = 0  # read by negative() when K(0) itself is singular
     n_a = negative(0.0)
     if negative(1.0) <= n_a:
         raise none

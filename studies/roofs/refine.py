@@ -174,12 +174,12 @@ def nonlinear(fam: str, state: float, done: list[dict], save=lambda rows: None) 
         and r["m"] in NONLINEAR_LEVELS
         and "instability_bracket" in r
     ]
-    have = {r["m"] for r in rows}
+    missing = [m for m in NONLINEAR_LEVELS if m not in {r["m"] for r in rows}]
+    if not missing:  # all cached: the roof need not be formed again
+        return rows
     cp, flat_xy, _ = roofs.folded(fam, state)
     sv, se = roofs.support_lines(cp, flat_xy, roofs.FAMILIES[fam]["axis"])
-    for m in NONLINEAR_LEVELS:
-        if m in have:
-            continue
+    for m in missing:
         rows.append(nonlinear_level(cp, sv, se, m))
         rows.sort(key=lambda r: r["m"])
         save(rows)
