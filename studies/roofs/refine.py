@@ -59,6 +59,8 @@ DOC = ROOT / "docs" / "roofs.md"
 CSV_MAIN = ROOT / "docs" / "roofs.csv"
 CSV_OUT = ROOT / "docs" / "roofs_refined.csv"
 CSV_NONLINEAR = ROOT / "docs" / "roofs_refined_nonlinear.csv"
+#: the imperfect roofs' checks (written by studies/roofs/imperfection.py from CSV_NONLINEAR)
+CSV_IMPERFECT = ROOT / "docs" / "roofs_imperfect.csv"
 START, END = "<!-- roofs-refined:start -->", "<!-- roofs-refined:end -->"
 
 #: refined when the stiffness changes by less than this between two levels (relative)
@@ -487,9 +489,40 @@ MEMBRANE_TOL = 0.05
 BASELINES = ("flat",)
 
 
+def imperfect_rows(path: Path = CSV_IMPERFECT) -> dict[str, list[dict[str, str]]]:
+    """The imperfect roofs' checks (one per imperfection amplitude) by roof key; empty
+    before the imperfection study ran."""
+    if not path.exists():
+        return {}
+    out: dict[str, list[dict[str, str]]] = {}
+    with path.open() as fh:
+        for r in csv.DictReader(fh):
+            out.setdefault(_key(r["family"], float(r["state"])), []).append(r)
+    return out
+
+
+def imperfect_verdict(r: dict, row: dict | None, imp: dict[str, list[dict[str, str]]]) -> str:
+    """What the buckling-mode imperfections do to a roof that carries the load perfect."""
+    said = []
+    for i in imp.get(_key(r["family"], r["state"]), []):
+        if i["error"]:
+            said.append(f"w0 = {i['imperfection']}: not completed")
+        elif i["critical_load_factor"]:
+            crit = float(i["critical_load_factor"])
+            said.append(f"**w0 = {i['imperfection']}: loses stability at {crit:.3f}**")
+        else:
+            grow = ""
+            if row is not None and row["deflection_nonlinear"]:
+                ratio = float(i["deflection_nonlinear"]) / row["deflection_nonlinear"]
+                grow = f" (deflection × {ratio:.2f})"
+            said.append(f"w0 = {i['imperfection']}: carries it{grow}")
+    return "; imperfect: " + ", ".join(said) if said else ""
+
+
 def ranking(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
     roofs_only = [r for r in results if r["family"] not in BASELINES]
     order = sorted(roofs_only, key=lambda r: -r["stiffness_per_width"])
+    imp = imperfect_rows()
     ok, bad = [], []
     for r in order:
         st, why = stable(r, coarse.get(_key(r["family"], r["state"])))
@@ -506,7 +539,7 @@ def ranking(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
                     " (below 1: imperfection-sensitive; linear / nonlinear deflection "
                     f"{row['deflection_linear'] / row['deflection_nonlinear']:.1f})"
                 )
-            ok.append(f"{len(ok) + 1}. {label}: {k}, {lb}")
+            ok.append(f"{len(ok) + 1}. {label}: {k}, {lb}{imperfect_verdict(r, row, imp)}")
         else:
             bad.append(f"- {label}: {k}; {why}" + ("" if "linear buckling" in why else f"; {lb}"))
     return "\n".join(
@@ -517,8 +550,9 @@ def ranking(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
             " sheet, a baseline, is left out. This is the perfect geometry: where the linear"
             " buckling factor beside it is below 1 (given with the ratio of the linear to the"
             " nonlinear deflection at the design load), it points to a critical point near the"
-            " path, so that roof is imperfection-sensitive and needs an imperfection study"
-            " before it is designed with (finding 7):",
+            " path, so that roof is imperfection-sensitive (finding 7). *Imperfect*: the same"
+            " roof with its first buckling mode as an initial imperfection w0 (section"
+            " *Imperfect* below):",
             "",
             *(ok or ["(none)"]),
             "",
@@ -706,6 +740,29 @@ def nonlinear_finding(results: list[dict], coarse: dict[str, dict[str, str]]) ->
             " points to a critical point nearby: an imperfect roof may not carry it, and the"
             " ranking marks these roofs imperfection-sensitive."
         )
+        imp = imperfect_rows()
+        seeded = [i for r in lba for i in imp.get(_key(r["family"], r["state"]), [])]
+        for name in dict.fromkeys(i["imperfection"] for i in seeded):
+            mine = [i for i in seeded if i["imperfection"] == name]
+            lost_i = [i for i in mine if i["critical_load_factor"] and not i["error"]]
+            kept_i = [i for i in mine if not i["critical_load_factor"] and not i["error"]]
+            parts.append(
+                f" Seeded with their first buckling mode at w0 = {name} (section *Imperfect*),"
+                f" {len(kept_i)} of them still carry the design load"
+                + (
+                    " and "
+                    + ", ".join(
+                        f"{i['family']} {float(i['state']):g}"
+                        f" ({float(i['critical_load_factor']):.3f})"
+                        for i in lost_i
+                    )
+                    + (" loses" if len(lost_i) == 1 else " lose")
+                    + " stability below it"
+                    if lost_i
+                    else ""
+                )
+                + "."
+            )
     if failed:
         parts.append(
             " The check failed on " + ", ".join(map(lab, failed)) + " (named in the table);"
