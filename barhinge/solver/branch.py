@@ -46,11 +46,6 @@ log = logging.getLogger(__name__)
 
 #: a model whose fold hinges all lie within this of 0 rad starts flat
 FLAT_START_TOL = 1e-6
-#: sub-steps of the rigid guide over the first requested step: an increment that is cut back
-#: near the flat state starts on the rigid fold itself, not on a chord between two rigid
-#: states (a chord shortens every bar by ~theta^2 / 8 of its length, which the stiff bars of
-#: a large sheet turn into a residual that Newton cannot recover from)
-GUIDE_FIRST_STEP = 8
 
 
 def is_flat(model: SolverModel) -> bool:
@@ -134,11 +129,8 @@ class RigidGuide:
     Attributes
     ----------
     X : (n_states, n_nodes, 3) float
-        Rigid-fold node coordinates at the path parameters ``t`` that the rigid path
-        reached (state 0 = the flat start), each placed on the supports.
-    t : (n_states,) float
-        Path parameter of each state: every requested step, and the first one also in
-        ``GUIDE_FIRST_STEP`` sub-steps where the actuators determine the motion.
+        Rigid-fold node coordinates at the requested steps that the rigid path reached
+        (state 0 = the flat start), each placed on the supports.
     record : dict
         What was chosen: ``predictor`` ("rigid panels" or "triangulated panels"),
         ``branch`` ("M/V assignment" or "target fold angles"), ``mirrored``,
@@ -149,7 +141,6 @@ class RigidGuide:
     """
 
     X: np.ndarray
-    t: np.ndarray
     record: dict[str, Any]
 
     @property
@@ -159,37 +150,11 @@ class RigidGuide:
 
     def at(self, t: float) -> np.ndarray:
         """(n_nodes, 3) rigid-fold coordinates at path parameter ``t`` in [0, t_max],
-        linear between the states."""
-        i = int(np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, len(self.t) - 2))
-        f = (t - self.t[i]) / (self.t[i + 1] - self.t[i])
+        linear between the requested steps."""
+        s = t * self.record["steps"]
+        i = min(int(np.floor(s)), len(self.X) - 2)
+        f = s - i
         return (1.0 - f) * self.X[i] + f * self.X[i + 1]
-
-
-def _first_step(
-    model: SolverModel,
-    actuators: Actuators,
-    steps: int,
-    options: dict[str, Any],
-    end: np.ndarray,
-) -> np.ndarray | None:
-    """Rigid-fold vertex coordinates of the first requested step cut into
-    ``GUIDE_FIRST_STEP`` equal sub-steps, (GUIDE_FIRST_STEP + 1, n_vertices, 3); None when
-    that rigid fold fails or does not end where the whole schedule's first step does
-    (``end``, its vertices: another branch)."""
-    k = GUIDE_FIRST_STEP
-    rows = actuators.schedule(steps)  # (steps + 1, n_act) degrees, row 0 = flat
-    table = rows[0] + (np.arange(1, k + 1) / k)[:, None] * (rows[1] - rows[0])
-    sub = dataclasses.replace(actuators, targets_deg=None, table_deg=table)
-    try:
-        path = rigid_fold(model.pattern, sub, steps=k, **options)
-    except BarhingeError as exc:
-        log.debug("first step of the rigid guide not refined: %s", exc)
-        return None
-    X = np.asarray(path.X)
-    size = float(np.ptp(X[0], axis=0).max())
-    if path.n_states != k + 1 or float(np.abs(X[-1] - end).max()) > 1e-8 * size:
-        return None
-    return X
 
 
 def rigid_guide(
@@ -222,10 +187,16 @@ def rigid_guide(
     opt = RigidOptions(check_rank=False)
     why = []
     for triangulated in (False, True):
-        kw = {"options": opt, "triangulated": triangulated, "fold_stiffness": w,
-              "diagonal_stiffness": kb}  # fmt: skip
         try:
-            path = rigid_fold(cp, actuators, steps=steps, **kw)
+            path = rigid_fold(
+                cp,
+                actuators,
+                steps=steps,
+                options=opt,
+                triangulated=triangulated,
+                fold_stiffness=w,
+                diagonal_stiffness=kb,
+            )
         except ConvergenceError as exc:
             path = exc.last_state
             if path is None or path.n_states < 2:
@@ -234,19 +205,9 @@ def rigid_guide(
         except BarhingeError as exc:
             why.append(f"{'triangulated' if triangulated else 'rigid'} panels: {exc}")
             continue
-        meta = path.meta
-        V, t = np.asarray(path.X), np.arange(path.n_states) / steps
-        least_squares = bool(max(meta.get("actuator_misfit_deg", [0.0])) > 1e-9)
-        if not (meta.get("free_dof") or least_squares):
-            # (free motions are resolved per step by the fold springs: a finer first step
-            # may settle in another minimum, so those guides keep the requested steps)
-            first = _first_step(model, actuators, steps, kw, V[1])
-            if first is not None:
-                V = np.concatenate([V[:1], first[1:-1], V[1:]])
-                sub = np.arange(1, GUIDE_FIRST_STEP) / (GUIDE_FIRST_STEP * steps)
-                t = np.concatenate([t[:1], sub, t[1:]])
         fx, ft = np.asarray(fixed, bool), np.asarray(fixed_target, float)
-        X = np.stack([_fit_supports(Xs, fx, ft) for Xs in _node_coordinates(model, V)])
+        X = np.stack([_fit_supports(Xs, fx, ft) for Xs in _node_coordinates(model, path.X)])
+        meta = path.meta
         record = {
             "predictor": "triangulated panels" if triangulated else "rigid panels",
             "branch": meta.get("branch"),
@@ -254,11 +215,11 @@ def rigid_guide(
             "sign_conflicts": list(meta.get("sign_conflicts", [])),
             "free_dof": meta.get("free_dof"),
             "events": list(meta.get("events", [])),
-            "least_squares": least_squares,
+            "least_squares": bool(max(meta.get("actuator_misfit_deg", [0.0])) > 1e-9),
             "steps": int(steps),
             "t_max": (path.n_states - 1) / steps,
         }
-        return RigidGuide(X=X, t=t, record=record)
+        return RigidGuide(X=X, record=record)
     log.warning(
         "no rigid fold predicts the first increment off the flat start (%s)", "; ".join(why)
     )

@@ -47,36 +47,11 @@ class FlatStart:
     def prediction(self, st: State, t1: float, lam1: float) -> State | None:
         """Rigid-fold prediction of the increment to ``t1`` (None: use the usual predictor).
 
-        Off a flat start the increments of the first step (the first, and those it is cut
-        into) are always predicted by the rigid fold of the schedule. Where the actuators
-        leave free motions, the increments that follow are predicted along it too, so the
-        model follows the branch of least fold-spring energy that the rigid fold chose
-        instead of the first equilibrium its own extrapolation meets."""
-        g = self._guide_for(st, t1)
-        if g is None:
-            return None
-        first_step = 1.0 / self.ctx.scene.steps
-        if st.t > 0.0 and t1 > first_step * (1 + 1e-9) and not g.record.get("free_dof"):
-            return None
-        return self._along(g, st, t1, lam1)
-
-    def alternative(self, st: State, t1: float, lam1: float) -> State | None:
-        """The rigid-fold prediction of a later increment, offered beside the driver's own
-        extrapolation (the driver keeps the one with the smaller residual); None where the
-        rigid fold does not reach ``t1``."""
-        g = self._guide_for(st, t1)
-        return None if g is None else self._along(g, st, t1, lam1)
-
-    def _along(self, g: RigidGuide, st: State, t1: float, lam1: float) -> State:
-        """``x = X_rigid(t1) + (x - X_rigid(t))``: the state moved along the rigid fold."""
-        ctx = self.ctx
-        x = g.at(t1).ravel() + (st.x - g.at(st.t).ravel())
-        new = State(x, st.mu.copy(), lam1, t1)
-        new.x[ctx.fixed] = ctx.fixed_coords(t1)
-        return new
-
-    def _guide_for(self, st: State, t1: float) -> RigidGuide | None:
-        """The rigid guide (computed on first use) if it reaches ``t1``."""
+        Off a flat start the first increment is always predicted by the rigid fold of the
+        schedule. Where the actuators leave free motions, the increments that follow are
+        predicted along it too, ``x = X_rigid(t1) + (x - X_rigid(t))``, so the model
+        follows the branch of least fold-spring energy that the rigid fold chose instead of
+        the first equilibrium its own extrapolation meets."""
         ctx = self.ctx
         assert ctx.scene.actuators is not None  # active: a flat start with actuators
         if self._guide is None and self.record is None:
@@ -97,7 +72,12 @@ class FlatStart:
         g = self._guide
         if g is None or t1 > g.t_max + 1e-12:
             return None
-        return g
+        if st.t > 0.0 and not g.record.get("free_dof"):
+            return None
+        x = g.at(t1).ravel() + (st.x - g.at(st.t).ravel())
+        new = State(x, st.mu.copy(), lam1, t1)
+        new.x[ctx.fixed] = ctx.fixed_coords(t1)
+        return new
 
     def events(self, records: list[StepRecord]) -> list[str]:
         """Events of the flat start: the rigid predictor's, and creases of the last state

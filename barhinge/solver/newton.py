@@ -197,8 +197,6 @@ class _Driver:
                 x, mu = st.x + f * (st.x - prev.x), st.mu + f * (st.mu - prev.mu)
             new = State(x, mu, lam1, t1)
             new.x[fixed] = ctx.fixed_coords(t1)
-            if self.flat.active:
-                return self._closer(new, self.flat.alternative(st, t1, lam1))
             return new
         e = ctx.evaluate(st)
         du_c = ctx.fixed_coords(t1) - st.x[fixed]
@@ -216,15 +214,6 @@ class _Driver:
         new.x[free] += dx
         new.x[fixed] = ctx.fixed_coords(t1)
         return new
-
-    def _closer(self, a: State, b: State | None) -> State:
-        """Of two predictions the one with the smaller force residual (``b`` may be None);
-        two residual evaluations without the tangent."""
-        if b is None:
-            return a
-        ctx, free = self.ctx, self.free
-        ra, rb = (float(np.linalg.norm(ctx.evaluate(s, tangent=False).r[free])) for s in (a, b))
-        return b if rb < ra else a
 
     # ------------------------------------------------------------ records
     def record(
