@@ -74,3 +74,16 @@ def test_critical_prefers_the_limit_point_then_the_estimate(study) -> None:
     assert study.critical({**row, "limit_load_factor": 0.7}) == 0.7
     assert study.critical({**row, "instability_estimate": None}) == 0.6
     assert study.critical({k: None for k in row}) is None
+
+
+def test_verdict_names_the_coarse_increment_where_the_finer_path_differs(study) -> None:
+    base = {"error": "", "limit_load_factor": None, "instability_load_factor": None,
+            "instability_estimate": None}  # fmt: skip
+    assert study.verdict(base) == "carries the design load"
+    flipped = {**base, "coarse_critical": 0.326}
+    assert study.verdict(flipped) == (
+        f"carries the design load (increment 1/{study.STEPS}: loses stability at 0.326)"
+    )
+    lost = {**base, "instability_estimate": 0.918, "coarse_critical": 0.667}
+    assert study.verdict(lost) == f"loses stability at 0.918 (increment 1/{study.STEPS}: 0.667)"
+    assert study.verdict({**base, "error": "no convergence"}) == "failed: no convergence"
