@@ -34,6 +34,8 @@ _LAZY = {
     "Material": "barhinge.model.material",
     "Scene": "barhinge.scene",
     "load_scene": "barhinge.scene",
+    "Imperfection": "barhinge.scene",
+    "seed_imperfection": "barhinge.analysis.imperfection",
     "solve": "barhinge.solver.newton",
     "tangent_stiffness": "barhinge.analysis.stiffness",
     "gaussian_curvature": "barhinge.analysis.curvature",

@@ -394,6 +394,12 @@ def fold_cmd(
     check_output_folder(out, overwrite=overwrite)  # before the solve, not after
     opts: dict[str, Any] = {"overwrite": overwrite, "pictures": level, "viewer": viewer}
     choice = None
+    wanted, amplitude = scene.imperfection, None
+    if wanted is not None:  # the amplitude of the scene as given, whatever model is chosen
+        from barhinge.analysis.imperfection import amplitude_length
+
+        amplitude = amplitude_length(scene)
+        scene = scene.with_(imperfection=None)
     if accuracy is not None:
         from barhinge.analysis.accuracy import scene_for_accuracy
 
@@ -409,6 +415,13 @@ def fold_cmd(
                           f"{c.name} (estimated error {100 * c.error:.2g} %)",
                           highlight=False, markup=False)  # fmt: skip
         form_only = form_only or c.name == "rigid"
+    if wanted is not None:
+        from barhinge.analysis.imperfection import seed_imperfection
+        from barhinge.output.summary import imperfection_text
+
+        scene = seed_imperfection(scene.with_(imperfection=wanted), amplitude=amplitude)
+        err_console.print("imperfection: " + imperfection_text(scene.model.meta["imperfection"]),
+                          highlight=False, markup=False)  # fmt: skip
     if form_only and form_only_model(scene)[0] == "rigid":
         try:
             rigid = rigid_form(scene)

@@ -26,6 +26,7 @@ from barhinge.loads import FollowerPressure, combine, line_load, pressure_load, 
 from barhinge.solver_options import SolverOptions
 
 __all__ = [
+    "Imperfection",
     "Scene",
     "default_scene",
     "load_scene",
@@ -34,6 +35,60 @@ __all__ = [
     "select_vertices",
     "self_weight",
 ]
+
+
+#: amplitude rules of an imperfection: "panel/N" (EN 1993-1-5, Annex C, C.5) or "span/N"
+AMPLITUDE_RULES = ("panel", "span")
+
+
+@dataclasses.dataclass(frozen=True)
+class Imperfection:
+    """An initial geometric imperfection a scene asks for: the structure is made stress-free
+    in the shape of its ``mode``-th linear buckling mode under the scene's loads, scaled to a
+    largest nodal displacement ``amplitude`` (applied by
+    :func:`barhinge.analysis.imperfection.seed_imperfection`; ``barhinge fold`` does).
+
+    Parameters
+    ----------
+    mode : int
+        Which buckling mode (1 = lowest factor).
+    amplitude : float or str
+        A length in the model's units (>= 0), or a rule: ``"panel/N"`` (the median over the
+        facets of each facet's shortest side, over N: EN 1993-1-5:2006, Annex C, C.5 takes
+        N = 200 for a plate panel) or ``"span/N"`` (twice the largest plan distance from a
+        node to the supports, supported nodes and pattern edges between two of them, over
+        N: the span of a roof on two supported edges; EN 1993-1-1:2005, Table 5.1 gives
+        N = 300 for a bow of curve a).
+    """
+
+    mode: int = 1
+    amplitude: float | str = "panel/200"
+
+    def __post_init__(self) -> None:
+        _check.integer(self.mode, "imperfection.mode", 1, 1000)
+        a = self.amplitude
+        if isinstance(a, str):
+            rule, _, den = a.partition("/")
+            try:
+                n = float(den)
+            except ValueError:
+                n = float("nan")
+            if rule not in AMPLITUDE_RULES or not (np.isfinite(n) and n > 0):
+                raise ConfigError(
+                    f"imperfection.amplitude = {a!r}; expected a length or 'panel/N' or "
+                    "'span/N' with N > 0"
+                )
+        else:
+            object.__setattr__(
+                self, "amplitude", _check.number(a, "imperfection.amplitude", lo=0.0)
+            )
+
+    def rule(self) -> tuple[str, float] | None:
+        """(``"panel"`` or ``"span"``, N) of a rule amplitude; None for a length."""
+        if not isinstance(self.amplitude, str):
+            return None
+        rule, _, den = self.amplitude.partition("/")
+        return rule, float(den)
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -67,6 +122,10 @@ class Scene:
     follower : FollowerPressure, optional
         A pressure along the facets' current normals, scaled by the load factor with
         ``loads`` (a follower load: re-evaluated at every iterate).
+    imperfection : Imperfection, optional
+        An initial imperfection in a buckling mode of ``loads``; the solver refuses a scene
+        whose model has not been seeded with it
+        (:func:`barhinge.analysis.imperfection.seed_imperfection`).
     """
 
     model: Any
@@ -80,6 +139,7 @@ class Scene:
     name: str = "scene"
     load_cases: dict[str, np.ndarray] | None = None
     follower: FollowerPressure | None = None
+    imperfection: Imperfection | None = None
 
     def __post_init__(self) -> None:
         if not hasattr(self.model, "n_nodes") or not hasattr(self.model, "X0"):
@@ -139,6 +199,13 @@ class Scene:
             fol.force(self.model, self.model.X0)  # checks the faces
         if control in ("load", "arc_length") and not np.any(L) and (fol is None or fol.p == 0):
             raise ConfigError(f"control {control!r} needs nonzero loads")
+        imp = self.imperfection
+        if imp is not None and not isinstance(imp, Imperfection):
+            raise ConfigError(f"imperfection must be an Imperfection, got {type(imp).__name__}")
+        if imp is not None and not np.any(L):
+            raise ConfigError(
+                "imperfection needs nonzero loads: its shape is a buckling mode of the loads"
+            )
         opts = self.options
         if opts is None or isinstance(opts, dict):
             opts = SolverOptions.from_dict(opts)
@@ -316,6 +383,7 @@ _TOP_KEYS = {
     "combinations",
     "prescribed",
     "actuators",
+    "imperfection",
     "solve",
 }
 #: upper bound of an integer parameter of a pattern family in a scene (cells, stories ...)
@@ -432,6 +500,13 @@ def _scene_from_dict(d: dict[str, Any], base_dir: Path) -> Scene:
         if loads is not None:
             raise ConfigError("give either [loads] or solve.load_case, not both")
         loads = cases[lcn]
+    imperfection = None
+    if "imperfection" in d:
+        imp = d["imperfection"]
+        _check_keys(imp, {"mode", "amplitude"}, "imperfection")
+        if "amplitude" not in imp:
+            raise ConfigError("imperfection needs amplitude = a length, 'panel/N' or 'span/N'")
+        imperfection = Imperfection(mode=imp.get("mode", 1), amplitude=imp["amplitude"])
     steps = _check.integer(solve.get("steps", 50), "solve.steps", 1, MAX_STEPS)
     control = _check.choice(solve.get("control", "auto"), "solve.control", CONTROLS)
     with _check.prefixed("solve.", {"options"}):
@@ -448,6 +523,7 @@ def _scene_from_dict(d: dict[str, Any], base_dir: Path) -> Scene:
         name=name,
         load_cases=cases or None,
         follower=follower,
+        imperfection=imperfection,
     )
 
 

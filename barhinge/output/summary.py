@@ -105,8 +105,20 @@ def run_summary(path: FoldPath, scene: Any = None) -> dict[str, Any]:
         "closure_residual": path.meta.get("max_closure"),
         # barhinge fold --accuracy: the model chosen and its estimated error
         "model_choice": path.meta.get("model_choice"),
+        # [imperfection]: the buckling mode the model is stress-free in, and its amplitude
+        "imperfection": path.meta.get("imperfection"),
     }
     return out
+
+
+def imperfection_text(rec: dict[str, Any]) -> str:
+    """An imperfection record (``model.meta["imperfection"]``) as one line: "buckling mode 1
+    (factor 0.53), amplitude 0.0133 = span/300"."""
+    text = ""
+    if rec.get("mode") is not None:
+        text = f"buckling mode {rec['mode']} (factor {rec['buckling_factor']:.4g}), "
+    text += f"amplitude {rec['amplitude']:.4g}"
+    return text + (f" = {rec['rule']}" if rec.get("rule") else "")
 
 
 def _percent(x: float) -> str:
@@ -177,6 +189,8 @@ def summary_rows(summary: dict[str, Any], path: FoldPath | None = None) -> list[
     mis = summary["actuators"].get("misfit_deg")
     if mis is not None and summary["actuators"].get("compliant"):
         rows.append(("compliant actuators: max |rho - target| (deg)", f"{mis:.4g}"))
+    if summary.get("imperfection"):
+        rows.append(("imperfection", imperfection_text(summary["imperfection"])))
     if summary.get("closure_residual") is not None:
         rows.append(("max loop-closure residual", f"{summary['closure_residual']:.2g}"))
     rows += _results_rows(summary.get("results") or {})

@@ -399,7 +399,14 @@ def solve(scene: Scene, progress: Progress | None = None) -> FoldPath:
         ``last_state`` is the partial FoldPath of the converged steps.
     Interrupted
         On Ctrl-C (a KeyboardInterrupt); its ``last_state`` is the converged part.
+    ConfigError
+        When the scene asks for an imperfection its model has not been seeded with.
     """
+    if scene.imperfection is not None and "imperfection" not in getattr(scene.model, "meta", {}):
+        raise ConfigError(
+            "the scene asks for an imperfection its model does not have: seed it with "
+            "barhinge.seed_imperfection(scene) before solving (barhinge fold does)"
+        )
     d = _Driver(scene)
     try:
         if scene.control == "arc_length":

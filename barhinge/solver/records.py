@@ -105,6 +105,9 @@ def build_path(
         "branch_events": branch_events,
         "newton": newton_summary(records, step_stats),
     }
+    imperfection = getattr(ctx.model, "meta", {}).get("imperfection")
+    if imperfection is not None:  # the model is stress-free in a buckling-mode shape
+        meta["imperfection"] = imperfection
     meta["negative_eigenvalues"] = [r.neg for r in rec]
     # distance of the actuators from their targets per state, deg (solver tolerance for
     # held actuators; the springs' stretch for compliant ones)

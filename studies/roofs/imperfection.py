@@ -39,6 +39,8 @@ from typing import Any
 
 import numpy as np
 
+from barhinge.analysis.imperfection import panel_side
+
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 import roofs  # noqa: E402
@@ -63,17 +65,6 @@ AMPLITUDES: dict[str, tuple[float, str]] = {
 STEPS, FINE_STEPS = 10, 40
 #: families that are baselines, not roofs (left out of the counts)
 BASELINES = ("flat",)
-
-
-def panel_side(cp) -> float:
-    """Median over the pattern's facets of each facet's shortest side (m)."""
-    V = np.asarray(cp.vertices, dtype=float)
-    shortest = []
-    for face in cp.faces:
-        P = V[np.asarray(face)]
-        sides = np.linalg.norm(np.roll(P, -1, axis=0) - P, axis=1)
-        shortest.append(float(sides.min()))
-    return float(np.median(shortest))
 
 
 def perfect_rows(path: Path = CSV_PERFECT) -> dict[tuple[str, float], dict[str, str]]:

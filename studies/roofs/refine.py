@@ -77,6 +77,11 @@ LEVELS = (1, 2, 4, 8, 16, 32, 64, 128)
 #: first limit point) on the refined panels: at these levels, the last one reported and the
 #: change from the one before as its refinement error
 NONLINEAR_LEVELS = (2, 4) if QUICK else (4, 8)
+#: first arc-length increment of every nonlinear check (1 / NONLINEAR_STEPS of the design
+#: load), and of the second look at a check that loses stability (a coarse increment can step
+#: from a stable state past the first critical point; the finer path is the one reported,
+#: with the coarse path's critical load factor beside it)
+NONLINEAR_STEPS, FINE_STEPS = 10, 40
 #: the shell reference of every roof (:func:`roofs.shell_level`, facet meshes graded towards
 #: the corners): these levels, then further until its Richardson estimate settles or the next
 #: level would exceed ``SHELL_DOF_BUDGET`` DOFs
@@ -136,12 +141,18 @@ def level(cp, sv: np.ndarray, se: np.ndarray, m: int) -> dict[str, Any]:
 
 
 def nonlinear_level(
-    cp, sv: np.ndarray, se: np.ndarray, m: int, keep_path: bool = False
+    cp,
+    sv: np.ndarray,
+    se: np.ndarray,
+    m: int,
+    keep_path: bool = False,
+    steps: int = NONLINEAR_STEPS,
 ) -> dict[str, Any]:
     """The nonlinear check of a roof with every panel cut into ``m x m`` sub-panels, under
     the design load (uniform load plus self-weight): :func:`roofs.nonlinear_check`, stopped
-    at the first loss of stability; beside it ``deflection_linear``, the largest deflection
-    of the linear response to the same load (m)."""
+    at the first loss of stability, first increment ``1 / steps`` of the load (recorded as
+    ``first_increment``); beside it ``deflection_linear``, the largest deflection of the
+    linear response to the same load (m)."""
     from barhinge.analysis.stiffness import linear_response
     from barhinge.errors import BarhingeError
     from barhinge.scene import self_weight
@@ -152,9 +163,12 @@ def nonlinear_level(
     P = P + self_weight(model, roofs.DENSITY * roofs.MATERIAL["t"], g=(0.0, 0.0, -roofs.G))
     U, _ = linear_response(model, P, S)
     row: dict[str, Any] = {"m": m, "membrane": MEMBRANE, "n_dof": 3 * model.n_nodes,
-                           "deflection_linear": float(np.max(-U[:, 2]))}  # fmt: skip
+                           "deflection_linear": float(np.max(-U[:, 2])),
+                           "first_increment": 1.0 / steps}  # fmt: skip
     try:
-        row |= roofs.nonlinear_check(model, S, P, stop_at_instability=True, keep_path=keep_path)
+        row |= roofs.nonlinear_check(
+            model, S, P, steps=steps, stop_at_instability=True, keep_path=keep_path
+        )
         row["error"] = ""
     except BarhingeError as exc:  # stated in the table, the other roofs still run
         row |= {"limit_load_factor": None, "instability_load_factor": None, "events": [],
@@ -166,9 +180,20 @@ def nonlinear_level(
     return row
 
 
+def needs_second_look(row: dict) -> bool:
+    """Whether a nonlinear check lost stability on a first increment coarser than
+    ``1 / FINE_STEPS`` (checks cached before ``first_increment`` was recorded used
+    ``1 / NONLINEAR_STEPS``)."""
+    if row.get("error") or critical(row) is None:
+        return False
+    return float(row.get("first_increment", 1.0 / NONLINEAR_STEPS)) > 1.0 / FINE_STEPS
+
+
 def nonlinear(fam: str, state: float, done: list[dict], save=lambda rows: None) -> list[dict]:
     """The nonlinear checks of one roof at ``NONLINEAR_LEVELS``: ``done`` (cached) extended,
-    ``save`` called after every new level."""
+    ``save`` called after every new check. A check that loses stability is run again from
+    the first increment ``1 / FINE_STEPS``; that one is kept, with the coarse one's critical
+    load factor as ``coarse_critical``."""
     rows = [
         r
         for r in done
@@ -177,15 +202,25 @@ def nonlinear(fam: str, state: float, done: list[dict], save=lambda rows: None) 
         and "instability_bracket" in r
     ]
     missing = [m for m in NONLINEAR_LEVELS if m not in {r["m"] for r in rows}]
-    if not missing:  # all cached: the roof need not be formed again
-        return rows
+    if not missing and not any(needs_second_look(r) for r in rows):
+        return rows  # all cached: the roof need not be formed again
     cp, flat_xy, _ = roofs.folded(fam, state)
     sv, se = roofs.support_lines(cp, flat_xy, roofs.FAMILIES[fam]["axis"])
-    for m in missing:
-        rows.append(nonlinear_level(cp, sv, se, m))
-        rows.sort(key=lambda r: r["m"])
+    for m in NONLINEAR_LEVELS:
+        r = next((x for x in rows if x["m"] == m), None)
+        if r is None:
+            r = nonlinear_level(cp, sv, se, m)
+        elif not needs_second_look(r):
+            continue
+        if needs_second_look(r):
+            print(f"  {fam} {state:g} nonlinear m = {m}: unstable at {critical(r):.3f}, again "
+                  f"with increment 1/{FINE_STEPS}", flush=True)  # fmt: skip
+            fine = nonlinear_level(cp, sv, se, m, steps=FINE_STEPS)
+            fine["coarse_critical"] = critical(r)
+            fine["time_s"] += r["time_s"]
+            r = fine
+        rows = sorted([x for x in rows if x["m"] != m] + [r], key=lambda x: x["m"])
         save(rows)
-        r = next(r for r in rows if r["m"] == m)
         print(f"  {fam} {state:g} nonlinear m = {m}: {r['n_dof']} DOF, unstable at "
               f"{r['instability_load_factor']}, reached {r['load_factor_reached']:.3f}, "
               f"{r['time_s']:.1f} s {r['error']}", flush=True)  # fmt: skip
