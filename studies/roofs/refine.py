@@ -479,12 +479,14 @@ def _inst(x: dict | None) -> str:
     if x.get("error"):
         return "failed: " + x["error"]
     crit = critical(x)
+    was = x.get("coarse_critical")
     if crit is None:
-        return "stable to 1"
+        return "stable to 1" + (f" (1/{NONLINEAR_STEPS}: {was:.3f})" if was is not None else "")
+    coarse = f"; 1/{NONLINEAR_STEPS}: {was:.3f}" if was is not None else ""
     if x.get("stop") == "limit_points":
-        return f"{crit:.3f} (limit point)"
+        return f"{crit:.3f} (limit point{coarse})"
     b = x.get("instability_bracket")
-    return f"{crit:.3f} ({b[0]:.3f}–{b[1]:.3f})" if b else f"{crit:.3f}"
+    return f"{crit:.3f} ({b[0]:.3f}–{b[1]:.3f}{coarse})" if b else f"{crit:.3f}{coarse}"
 
 
 def nonlinear_table(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
@@ -725,6 +727,24 @@ def nonlinear_finding(results: list[dict], coarse: dict[str, dict[str, str]]) ->
         f" (table below). At m = {m}, {len(lost)} of {len(checked)} roofs lose stability below"
         f" the design load (one facet per panel: {len(lost_one)} of {len(with_one)})."
     ]
+    looked = [(r, x) for r in checked for x in r["nonlinear"] if "coarse_critical" in x]
+    if looked:
+        turned = [(r, x) for r, x in looked if critical(x) is None]
+        parts.append(
+            f" Every check that lost stability from a first increment of 1/{NONLINEAR_STEPS}"
+            f" was followed again from 1/{FINE_STEPS} ({len(looked)} checks), and that path's"
+            " verdict is the one given: a coarse increment can step from a stable state past"
+            " the first critical point."
+            + (
+                " With the finer increment "
+                + ", ".join(
+                    f"{lab(r)} at m = {x['m']} (was {x['coarse_critical']:.3f})" for r, x in turned
+                )  # fmt: skip
+                + " carry the design load."
+                if turned
+                else " No verdict changed."
+            )
+        )
     if ratio:
         parts.append(
             f" Where both lose it, the refined load factor over the one-facet one is"
@@ -919,7 +939,8 @@ def write_nonlinear_csv(results: list[dict], path: Path) -> None:
     and the critical load factor (:func:`critical`), deflections (m), cost."""
     cols = ["family", "state", "m", "n_dof", "stop", "critical_load_factor",
             "bracket_low", "bracket_high", "load_factor_reached", "deflection_linear",
-            "deflection_nonlinear", "states", "iterations", "time_s", "error"]  # fmt: skip
+            "deflection_nonlinear", "states", "iterations", "first_increment",
+            "coarse_critical", "time_s", "error"]  # fmt: skip
     with path.open("w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(cols)
@@ -930,6 +951,7 @@ def write_nonlinear_csv(results: list[dict], path: Path) -> None:
                 vals = {**x, "family": r["family"], "state": r["state"],
                         "critical_load_factor": crit, "bracket_low": b[0], "bracket_high": b[1],
                         "stop": x.get("stop", ""), "states": x.get("states", ""),
+                        "first_increment": x.get("first_increment", 1.0 / NONLINEAR_STEPS),
                         "iterations": x.get("iterations", "")}  # fmt: skip
                 w.writerow(
                     ["" if vals.get(c) is None else f"{vals[c]:.6g}" if isinstance(vals[c], float)
@@ -1002,7 +1024,11 @@ def section(results: list[dict]) -> str:
             " at a limit point, else where the tangent, interpolated between the last stable"
             " state and that one, turns singular"
             " (`barhinge.analysis.buckling.critical_between`), with the two states' load factors"
-            " in brackets. Then the change between the refined levels, where the refined path"
+            " in brackets. A refined check that loses stability from a first increment of"
+            f" 1/{NONLINEAR_STEPS} of the design load is followed again from 1/{FINE_STEPS}; that"
+            f" path is given, with the 1/{NONLINEAR_STEPS} path's value after it"
+            f" (*1/{NONLINEAR_STEPS}: …*)."
+            " Then the change between the refined levels, where the refined path"
             " ends and its largest deflection there (every level:"
             " [roofs_refined_nonlinear.csv](roofs_refined_nonlinear.csv)).",
             "",

@@ -278,3 +278,39 @@ def test_nonlinear_csv_has_every_level(study, tmp_path) -> None:
         assert int(row["m"]) == x["m"] and row["stop"] == x["stop"]
         crit = study.critical(x)
         assert (row["critical_load_factor"] == "") == (crit is None)
+
+
+def test_a_check_that_loses_stability_gets_a_second_look(study, monkeypatch) -> None:
+    """A nonlinear check that loses stability from the first increment 1/10 is run again from
+    1/40 and that path is kept, with the coarse one's critical load factor; a check that
+    carries the load, or one already from 1/40, is not run again."""
+    calls = []
+
+    def fake(cp, sv, se, m, keep_path=False, steps=study.NONLINEAR_STEPS):
+        calls.append((m, steps))
+        lost = steps == study.NONLINEAR_STEPS and m == study.NONLINEAR_LEVELS[-1]
+        return {"m": m, "membrane": study.MEMBRANE, "n_dof": 10, "first_increment": 1.0 / steps,
+                "instability_load_factor": 0.6 if lost else None, "instability_estimate": 0.55
+                if lost else None, "instability_bracket": [0.5, 0.6] if lost else None,
+                "limit_load_factor": None, "stop": "instability" if lost else "load_factor",
+                "load_factor_reached": 0.6 if lost else 1.0, "error": "", "events": [],
+                "time_s": 1.0}  # fmt: skip
+
+    monkeypatch.setattr(study, "nonlinear_level", fake)
+    saved = []
+    rows = study.nonlinear("pleats", 90.0, [], saved.append)
+    lo, hi = study.NONLINEAR_LEVELS
+    assert calls == [(lo, study.NONLINEAR_STEPS), (hi, study.NONLINEAR_STEPS),
+                     (hi, study.FINE_STEPS)]  # fmt: skip
+    fine = rows[-1]
+    assert fine["m"] == hi and fine["coarse_critical"] == 0.55 and study.critical(fine) is None
+    assert fine["time_s"] == 2.0  # both paths' cost
+    assert study._inst(fine) == f"stable to 1 (1/{study.NONLINEAR_STEPS}: 0.550)"
+    calls.clear()
+    assert study.nonlinear("pleats", 90.0, rows, saved.append) == rows
+    assert calls == []  # nothing to look at again
+    # a cached coarse check without ``first_increment`` (written before it was recorded)
+    old = {k: v for k, v in fake(None, None, None, hi).items() if k != "first_increment"}
+    calls.clear()
+    study.nonlinear("pleats", 90.0, [rows[0], old], saved.append)
+    assert calls == [(hi, study.FINE_STEPS)]
