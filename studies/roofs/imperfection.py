@@ -20,11 +20,18 @@ The imperfect roof is then followed by the same arc length as the perfect one
 (:func:`roofs.nonlinear_check`, stopped at the first loss of stability) on the same refined
 panels (m = ``LEVEL``).
 
-Run: ``python studies/roofs/imperfection.py [--quick] [--publish] [--cache=FILE]
-[--only=FAMILY,...]``. Each roof is written to the cache as soon as it is checked (default
-``imperfection_cache.json`` beside this script), so an interrupted run resumes. ``--publish``
-writes the section of docs/roofs.md between the ``roofs-imperfect`` markers and
-docs/roofs_imperfect.csv. ``--quick``: two roofs at m = 2 (a smoke run, nothing published).
+With ``--sensitivity``, one roof per family (the carried roof of lowest first buckling
+factor) is also seeded in its buckling modes 2 .. 4 at both amplitudes and in its first mode
+at the larger bows span/150 and span/75 (``SENSITIVITY_MODES``, ``SENSITIVITY_AMPLITUDES``;
+EN 1993-1-6:2007, 8.7.2: the most unfavourable shape and amplitude), written between the
+``roofs-imperfect-sensitivity`` markers and to docs/roofs_imperfect_sensitivity.csv.
+
+Run: ``python studies/roofs/imperfection.py [--quick] [--publish] [--sensitivity]
+[--cache=FILE] [--only=FAMILY,...]``. Each roof is written to the cache as soon as it is
+checked (default ``imperfection_cache.json`` beside this script), so an interrupted run
+resumes. ``--publish`` writes the section of docs/roofs.md between the ``roofs-imperfect``
+markers and docs/roofs_imperfect.csv. ``--quick``: two roofs at m = 2 (a smoke run, nothing
+published).
 """
 
 from __future__ import annotations
@@ -59,6 +66,17 @@ AMPLITUDES: dict[str, tuple[float, str]] = {
     "b/200": (1.0 / 200.0, "panel"),  # EN 1993-1-5, Annex C, C.5
     "span/300": (1.0 / 300.0, "span"),  # EN 1993-1-1, Table 5.1, curve a, elastic
 }
+#: the sensitivity study (``--sensitivity``): the higher buckling modes seeded at the code
+#: amplitudes, and larger multiples of the global bow on the first mode (EN 1993-1-6:2007,
+#: 8.7.2 asks for the most unfavourable imperfection shape and amplitude)
+SENSITIVITY_MODES = (2, 3, 4)
+SENSITIVITY_AMPLITUDES: dict[str, tuple[float, str]] = {
+    "span/150": (1.0 / 150.0, "span"),
+    "span/75": (1.0 / 75.0, "span"),
+}
+SENS_CSV = HERE.parents[1] / "docs" / "roofs_imperfect_sensitivity.csv"
+SENS_START = "<!-- roofs-imperfect-sensitivity:start -->"
+SENS_END = "<!-- roofs-imperfect-sensitivity:end -->"
 #: first arc-length increment of every check (1 / STEPS of the design load), and of the
 #: second look at a roof that loses stability (a coarse increment can jump past the first
 #: critical point; the finer path's estimate is the one reported)
@@ -82,13 +100,16 @@ def carries(row: dict[str, str]) -> bool:
 
 def amplitude(name: str, cp) -> float:
     """The imperfection amplitude ``name`` (a key of ``AMPLITUDES``) of a roof, m."""
-    fraction, of = AMPLITUDES[name]
+    fraction, of = {**AMPLITUDES, **SENSITIVITY_AMPLITUDES}[name]
     return fraction * (panel_side(cp) if of == "panel" else roofs.SPAN)
 
 
-def check(family: str, state: float, m: int, name: str, steps: int = STEPS) -> dict[str, Any]:
+def check(
+    family: str, state: float, m: int, name: str, steps: int = STEPS, mode: int = 1
+) -> dict[str, Any]:
     """The roof's nonlinear check at ``m x m`` sub-panels per panel with the imperfection
-    ``name`` (a key of ``AMPLITUDES``), first arc-length increment ``1 / steps``."""
+    ``name`` (a key of ``AMPLITUDES`` or ``SENSITIVITY_AMPLITUDES``) in the shape of buckling
+    mode ``mode`` (1 = lowest), first arc-length increment ``1 / steps``."""
     from barhinge.analysis.buckling import linear_buckling
     from barhinge.analysis.imperfection import imperfect
     from barhinge.errors import BarhingeError
@@ -103,11 +124,13 @@ def check(family: str, state: float, m: int, name: str, steps: int = STEPS) -> d
     w0 = amplitude(name, cp)
     row: dict[str, Any] = {"family": family, "state": state, "m": m, "n_dof": 3 * model.n_nodes,
                            "imperfection": name, "panel_side": panel_side(cp),
-                           "amplitude": w0}  # fmt: skip
+                           "amplitude": w0, "mode": mode}  # fmt: skip
     try:
-        buck = linear_buckling(model, P, S, n_modes=1)
-        row["buckling_factor"] = float(buck.factors[0])
-        seeded = imperfect(model, buck.modes[0], w0, loads=P)
+        buck = linear_buckling(model, P, S, n_modes=mode)
+        if len(buck.factors) < mode:
+            raise BarhingeError(f"only {len(buck.factors)} positive buckling factors")
+        row["buckling_factor"] = float(buck.factors[mode - 1])
+        seeded = imperfect(model, buck.modes[mode - 1], w0, loads=P)
         row |= roofs.nonlinear_check(seeded, S, P, steps=steps, stop_at_instability=True)
         row["first_increment"] = 1.0 / steps
         row["error"] = ""
@@ -135,20 +158,31 @@ def critical(row: dict[str, Any]) -> float | None:
     return None
 
 
-def run(roof_list: list[tuple[str, float]], m: int, cache: Path | None) -> list[dict]:
-    """Check every roof at every amplitude (cached ones are read back), writing the cache
-    after each check."""
+def _key(fam: str, state: float, m: int, name: str, mode: int = 1) -> str:
+    return f"{fam}/{state:g}/m{m}/{name}" + (f"/mode{mode}" if mode != 1 else "")
+
+
+def run(
+    roof_list: list[tuple[str, float]],
+    m: int,
+    cache: Path | None,
+    tasks: list[tuple[str, int]] | None = None,
+) -> list[dict]:
+    """Check every roof at every (amplitude, mode) of ``tasks`` (default: every amplitude of
+    ``AMPLITUDES`` on mode 1); cached checks are read back, the cache is written after each
+    check."""
     store: dict[str, dict] = (
         json.loads(cache.read_text()) if cache is not None and cache.exists() else {}
     )
     rows = []
-    todo = [(fam, state, name) for name in AMPLITUDES for fam, state in roof_list]
-    for k, (fam, state, name) in enumerate(todo, 1):
-        key = f"{fam}/{state:g}/m{m}/{name}"
+    tasks = [(name, 1) for name in AMPLITUDES] if tasks is None else tasks
+    todo = [(fam, state, name, mode) for name, mode in tasks for fam, state in roof_list]
+    for k, (fam, state, name, mode) in enumerate(todo, 1):
+        key = _key(fam, state, m, name, mode)
         if key not in store:
-            print(f"[{k}/{len(todo)}] {fam} {state:g} (m = {m}, w0 = {name})", file=sys.stderr,
-                  flush=True)  # fmt: skip
-            store[key] = check(fam, state, m, name)
+            print(f"[{k}/{len(todo)}] {fam} {state:g} (m = {m}, w0 = {name}, mode {mode})",
+                  file=sys.stderr, flush=True)  # fmt: skip
+            store[key] = check(fam, state, m, name, mode=mode)
             if cache is not None:
                 cache.write_text(json.dumps(store, indent=0))
         coarse = store[key]
@@ -156,12 +190,12 @@ def run(roof_list: list[tuple[str, float]], m: int, cache: Path | None) -> list[
         if critical(coarse) is not None and coarse_increment > 1.0 / FINE_STEPS:
             print(f"  {fam} {state:g} loses stability: again with increment 1/{FINE_STEPS}",
                   file=sys.stderr, flush=True)  # fmt: skip
-            fine = check(fam, state, m, name, steps=FINE_STEPS)
+            fine = check(fam, state, m, name, steps=FINE_STEPS, mode=mode)
             fine["coarse_critical"] = critical(coarse)
             store[key] = fine
             if cache is not None:
                 cache.write_text(json.dumps(store, indent=0))
-        rows.append(store[key])
+        rows.append({"mode": 1, **store[key]})  # checks cached before modes were recorded
     return rows
 
 
@@ -291,8 +325,143 @@ def section(rows: list[dict], perfect: dict[tuple[str, float], dict[str, str]]) 
     )
 
 
+def sensitivity_roofs(rows: list[dict]) -> list[tuple[str, float]]:
+    """One roof per family (baselines left out): the carried roof whose first linear
+    buckling factor is lowest, the one the linear estimate calls the most sensitive."""
+    best: dict[str, dict] = {}
+    for r in rows:
+        if r["family"] in BASELINES or r["mode"] != 1 or r["error"]:
+            continue
+        b = best.get(r["family"])
+        if b is None or r["buckling_factor"] < b["buckling_factor"]:
+            best[r["family"]] = r
+    return [(r["family"], float(r["state"])) for r in best.values()]
+
+
+def sensitivity_tasks() -> list[tuple[str, int]]:
+    """(amplitude, mode) of the sensitivity study: modes 1 .. 4 at the code amplitudes, and
+    the larger bows on mode 1."""
+    modes = (1, *SENSITIVITY_MODES)
+    return [(n, k) for k in modes for n in AMPLITUDES] + [(n, 1) for n in SENSITIVITY_AMPLITUDES]
+
+
+def _effect(r: dict, perfect: dict[tuple[str, float], dict[str, str]]) -> str:
+    """A check as a cell: where stability is lost, or the deflection at the design load over
+    the perfect roof's."""
+    if r["error"]:
+        return "failed: " + r["error"]
+    c = critical(r)
+    if c is not None:
+        return f"loses stability at {c:.3f}"
+    ratio = r["deflection_nonlinear"] / float(
+        perfect[(r["family"], float(r["state"]))]["deflection_nonlinear"]
+    )
+    return f"× {ratio:.2f}"
+
+
+def _severity(r: dict, perfect: dict[tuple[str, float], dict[str, str]]) -> float:
+    """Order of harm: a loss of stability (earlier worse) before any deflection growth."""
+    if r["error"]:
+        return -np.inf
+    c = critical(r)
+    if c is not None:
+        return 10.0 - c
+    return r["deflection_nonlinear"] / float(
+        perfect[(r["family"], float(r["state"]))]["deflection_nonlinear"]
+    )
+
+
+def sensitivity_section(rows: list[dict], perfect: dict[tuple[str, float], dict[str, str]]) -> str:
+    """The sensitivity subsection: every selected roof at modes 1 .. 4 and the larger bows."""
+    from barhinge._publish import generated_stamp
+
+    by: dict[tuple[str, float], dict[tuple[str, int], dict]] = {}
+    for r in rows:
+        by.setdefault((r["family"], float(r["state"])), {})[(r["imperfection"], r["mode"])] = r
+    modes = (1, *SENSITIVITY_MODES)
+    names = list(AMPLITUDES)
+    head = "| roof | state | mode | buckling factor |" + "".join(f" {n} |" for n in names)
+    lines = [head, "|" + "---|" * (4 + len(names))]
+    worst_mode = {}
+    for (fam, state), got in by.items():
+        for k in modes:
+            first = got[(names[0], k)]
+            cells = [fam, f"{state:g}", str(k), _num(first["buckling_factor"])]
+            cells += [_effect(got[(n, k)], perfect) for n in names]
+            lines.append("| " + " | ".join(cells) + " |")
+        for n in names:
+            worst = max(modes, key=lambda k, n=n: _severity(got[(n, k)], perfect))
+            worst_mode[(fam, state, n)] = worst
+    amps = [*names, *SENSITIVITY_AMPLITUDES]
+    head2 = "| roof | state |" + "".join(f" w0 = {n} |" for n in amps)
+    lines2 = [head2, "|" + "---|" * (2 + len(amps))]
+    for (fam, state), got in by.items():
+        cells = [fam, f"{state:g}"] + [
+            f"{1e3 * got[(n, 1)]['amplitude']:.1f} mm: {_effect(got[(n, 1)], perfect)}"
+            for n in amps
+        ]
+        lines2.append("| " + " | ".join(cells) + " |")
+    lost = [r for r in rows if not r["error"] and critical(r) is not None]
+    bullets = []
+    for (fam, state), got in by.items():
+        worse = [
+            f"{n}: mode {worst_mode[(fam, state, n)]}, "
+            f"{_effect(got[(n, worst_mode[(fam, state, n)])], perfect)} against "
+            f"{_effect(got[(n, 1)], perfect)}"
+            for n in names
+            if worst_mode[(fam, state, n)] != 1
+        ]
+        bullets.append(
+            f"- {fam} {state:g}: "
+            + ("; ".join(worse) if worse else "the first mode is the most harmful at both")
+            + "."
+        )
+    summary_text = (
+        "The most harmful mode at each code amplitude (the earliest loss of stability, else"
+        " the largest deflection), where it is not the first:\n\n"
+        + "\n".join(bullets)
+        + "\n\n"
+        + (
+            f"{len(lost)} of the {len(rows)} checks lose stability below the design load: "
+            + ", ".join(
+                f"{r['family']} {r['state']:g} (mode {r['mode']}, w0 = "
+                f"{r['imperfection']}) at {critical(r):.3f}"
+                for r in lost
+            )  # fmt: skip
+            + "."
+            if lost
+            else f"All {len(rows)} checks carry the design load."
+        )
+    )
+    return "\n".join(
+        [
+            SENS_START,
+            "",
+            generated_stamp("python studies/roofs/imperfection.py --sensitivity --publish"),
+            "",
+            f"Data: [roofs_imperfect_sensitivity.csv](roofs_imperfect_sensitivity.csv). For"
+            " each family, the carried roof with the lowest first buckling factor, seeded in"
+            f" each of its first {len(modes)} buckling modes at the two code amplitudes, and in"
+            " its first mode at larger global bows (EN 1993-1-6, 8.7.2 asks for the most"
+            " unfavourable shape and amplitude). Same check as above; a cell gives where the"
+            " imperfect roof loses stability, or its largest deflection at the design load"
+            " over the perfect roof's (× …).",
+            "",
+            summary_text,
+            "",
+            "\n".join(lines),
+            "",
+            "First mode, growing amplitude:",
+            "",
+            "\n".join(lines2),
+            "",
+            SENS_END,
+        ]
+    )
+
+
 def write_csv(rows: list[dict], path: Path = CSV_OUT) -> None:
-    cols = ["family", "state", "imperfection", "m", "n_dof", "panel_side", "amplitude",
+    cols = ["family", "state", "imperfection", "mode", "m", "n_dof", "panel_side", "amplitude",
             "buckling_factor",
             "stop", "critical_load_factor", "coarse_critical", "first_increment",
             "load_factor_reached", "deflection_nonlinear",
@@ -317,6 +486,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--publish", action="store_true", help="rewrite the docs section and CSV")
     ap.add_argument("--cache", type=Path, default=None, help="JSON file of checked roofs")
     ap.add_argument("--only", default=None, help="comma-separated families (no publish)")
+    ap.add_argument("--sensitivity", action="store_true",
+                    help="also seed modes 2-4 and larger bows on one roof per family")  # fmt: skip
     a = ap.parse_args(argv)
     perfect = perfect_rows()
     roof_list = [k for k, r in perfect.items() if carries(r)]
@@ -335,6 +506,16 @@ def main(argv: list[str] | None = None) -> None:
         write_between(DOC, START, END, text[len(START) : -len(END)])
         write_csv(rows)
         print(f"wrote {DOC}, {CSV_OUT}")
+    if a.sensitivity:
+        sens = run(sensitivity_roofs(rows), m, cache, sensitivity_tasks())
+        text = sensitivity_section(sens, perfect)
+        print(text)
+        if a.publish and not (a.quick or a.only):
+            from barhinge._publish import write_between
+
+            write_between(DOC, SENS_START, SENS_END, text[len(SENS_START) : -len(SENS_END)])
+            write_csv(sens, SENS_CSV)
+            print(f"wrote {DOC}, {SENS_CSV}")
 
 
 if __name__ == "__main__":

@@ -87,3 +87,46 @@ def test_verdict_names_the_coarse_increment_where_the_finer_path_differs(study) 
     lost = {**base, "instability_estimate": 0.918, "coarse_critical": 0.667}
     assert study.verdict(lost) == f"loses stability at 0.918 (increment 1/{study.STEPS}: 0.667)"
     assert study.verdict({**base, "error": "no convergence"}) == "failed: no convergence"
+
+
+def test_sensitivity_tasks_and_amplitudes(study) -> None:
+    """Modes 1 .. 4 at both code amplitudes, and the first mode at the larger bows, whose
+    amplitudes are the span of 4 m over 150 and 75."""
+    tasks = study.sensitivity_tasks()
+    assert len(tasks) == len(set(tasks)) == 4 * len(study.AMPLITUDES) + 2
+    assert {k for _, k in tasks} == {1, 2, 3, 4}
+    assert ("span/75", 1) in tasks and ("span/75", 2) not in tasks
+    import roofs
+
+    cp = roofs.folded("pleats", 90.0)[0]
+    assert study.amplitude("span/150", cp) == pytest.approx(4.0 / 150)
+    assert study.amplitude("span/75", cp) == pytest.approx(4.0 / 75)
+
+
+def _row(fam, state, name, mode, factor=0.5, deflection=0.01, crit=None):
+    return {"family": fam, "state": state, "imperfection": name, "mode": mode, "error": "",
+            "buckling_factor": factor, "amplitude": 0.01, "deflection_nonlinear": deflection,
+            "limit_load_factor": None, "instability_load_factor": crit,
+            "instability_estimate": crit}  # fmt: skip
+
+
+def test_sensitivity_picks_the_lowest_factor_and_names_the_worst_mode(study) -> None:
+    """One roof per family, the lowest first buckling factor, baselines left out; the worst
+    mode is the earliest loss of stability, else the largest deflection."""
+    first = [_row("pleats", 30.0, "b/200", 1, factor=0.13), _row("pleats", 90.0, "b/200", 1),
+             _row("flat", 0.0, "b/200", 1, factor=0.01),
+             _row("pleats", 60.0, "b/200", 2, factor=0.01)]  # fmt: skip
+    assert study.sensitivity_roofs(first) == [("pleats", 30.0)]
+    perfect = {("pleats", 30.0): {"deflection_nonlinear": "0.01"}}
+    rows = [_row("pleats", 30.0, n, k, deflection=0.01 * (1 + k / 10)) for n, k in
+            study.sensitivity_tasks()]  # fmt: skip
+    rows[study.sensitivity_tasks().index(("span/300", 2))].update(
+        instability_load_factor=0.8, instability_estimate=0.8
+    )
+    text = study.sensitivity_section(rows, perfect)
+    assert text.startswith(study.SENS_START) and text.endswith(study.SENS_END)
+    # b/200: the largest deflection (mode 4); span/300: the loss of stability (mode 2)
+    assert "b/200: mode 4, × 1.40 against × 1.10" in text
+    assert "span/300: mode 2, loses stability at 0.800 against × 1.10" in text
+    assert "1 of the 10 checks lose stability" in text
+    assert text.count("| pleats | 30 |") == 4 + 1  # four modes, one amplitude row
