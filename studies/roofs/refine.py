@@ -181,19 +181,19 @@ def nonlinear_level(
 
 
 def needs_second_look(row: dict) -> bool:
-    """Whether a nonlinear check lost stability on a first increment coarser than
-    ``1 / FINE_STEPS`` (checks cached before ``first_increment`` was recorded used
+    """Whether a nonlinear check lost stability, or failed, on a first increment coarser
+    than ``1 / FINE_STEPS`` (checks cached before ``first_increment`` was recorded used
     ``1 / NONLINEAR_STEPS``)."""
-    if row.get("error") or critical(row) is None:
+    if not row.get("error") and critical(row) is None:
         return False
     return float(row.get("first_increment", 1.0 / NONLINEAR_STEPS)) > 1.0 / FINE_STEPS
 
 
 def nonlinear(fam: str, state: float, done: list[dict], save=lambda rows: None) -> list[dict]:
     """The nonlinear checks of one roof at ``NONLINEAR_LEVELS``: ``done`` (cached) extended,
-    ``save`` called after every new check. A check that loses stability is run again from
-    the first increment ``1 / FINE_STEPS``; that one is kept, with the coarse one's critical
-    load factor as ``coarse_critical``."""
+    ``save`` called after every new check. A check that loses stability or fails is run
+    again from the first increment ``1 / FINE_STEPS``; that one is kept, with the coarse
+    one's critical load factor as ``coarse_critical`` (or its failure as ``coarse_error``)."""
     rows = [
         r
         for r in done
@@ -213,10 +213,14 @@ def nonlinear(fam: str, state: float, done: list[dict], save=lambda rows: None) 
         elif not needs_second_look(r):
             continue
         if needs_second_look(r):
-            print(f"  {fam} {state:g} nonlinear m = {m}: unstable at {critical(r):.3f}, again "
-                  f"with increment 1/{FINE_STEPS}", flush=True)  # fmt: skip
+            why = f"failed ({r['error']})" if r.get("error") else f"unstable at {critical(r):.3f}"
+            print(f"  {fam} {state:g} nonlinear m = {m}: {why}, again with increment "
+                  f"1/{FINE_STEPS}", flush=True)  # fmt: skip
             fine = nonlinear_level(cp, sv, se, m, steps=FINE_STEPS)
-            fine["coarse_critical"] = critical(r)
+            if r.get("error"):
+                fine["coarse_error"] = r["error"]
+            else:
+                fine["coarse_critical"] = critical(r)
             fine["time_s"] += r["time_s"]
             r = fine
         rows = sorted([x for x in rows if x["m"] != m] + [r], key=lambda x: x["m"])
@@ -480,9 +484,12 @@ def _inst(x: dict | None) -> str:
         return "failed: " + x["error"]
     crit = critical(x)
     was = x.get("coarse_critical")
+    coarse = f"1/{NONLINEAR_STEPS}: {was:.3f}" if was is not None else ""
+    if x.get("coarse_error"):
+        coarse = f"1/{NONLINEAR_STEPS}: failed at {_failed_at({'error': x['coarse_error']})}"
     if crit is None:
-        return "stable to 1" + (f" (1/{NONLINEAR_STEPS}: {was:.3f})" if was is not None else "")
-    coarse = f"; 1/{NONLINEAR_STEPS}: {was:.3f}" if was is not None else ""
+        return "stable to 1" + (f" ({coarse})" if coarse else "")
+    coarse = f"; {coarse}" if coarse else ""
     if x.get("stop") == "limit_points":
         return f"{crit:.3f} (limit point{coarse})"
     b = x.get("instability_bracket")
@@ -728,6 +735,7 @@ def nonlinear_finding(results: list[dict], coarse: dict[str, dict[str, str]]) ->
         f" the design load (one facet per panel: {len(lost_one)} of {len(with_one)})."
     ]
     looked = [(r, x) for r in checked for x in r["nonlinear"] if "coarse_critical" in x]
+    rescued = [(r, x) for r in results for x in r.get("nonlinear", []) if x.get("coarse_error")]
     if looked:
         turned = [(r, x) for r, x in looked if critical(x) is None]
         parts.append(
@@ -744,6 +752,13 @@ def nonlinear_finding(results: list[dict], coarse: dict[str, dict[str, str]]) ->
                 if turned
                 else " No verdict changed."
             )
+        )
+    for r, x in rescued:
+        parts.append(
+            f" The check of {lab(r)} at m = {x['m']} failed from 1/{NONLINEAR_STEPS} (at load"
+            f" factor {_failed_at({'error': x['coarse_error']})}) and was run again from"
+            f" 1/{FINE_STEPS}: "
+            + (f"failed again ({x['error']})." if x.get("error") else f"{_inst(x)}.")
         )
     if ratio:
         parts.append(
@@ -940,7 +955,7 @@ def write_nonlinear_csv(results: list[dict], path: Path) -> None:
     cols = ["family", "state", "m", "n_dof", "stop", "critical_load_factor",
             "bracket_low", "bracket_high", "load_factor_reached", "deflection_linear",
             "deflection_nonlinear", "states", "iterations", "first_increment",
-            "coarse_critical", "time_s", "error"]  # fmt: skip
+            "coarse_critical", "coarse_error", "time_s", "error"]  # fmt: skip
     with path.open("w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(cols)

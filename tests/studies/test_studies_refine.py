@@ -314,3 +314,29 @@ def test_a_check_that_loses_stability_gets_a_second_look(study, monkeypatch) -> 
     calls.clear()
     study.nonlinear("pleats", 90.0, [rows[0], old], saved.append)
     assert calls == [(hi, study.FINE_STEPS)]
+
+
+def test_a_failed_check_gets_a_second_look_once(study, monkeypatch) -> None:
+    """A check that fails from 1/10 is run again from 1/40; the coarse failure is kept as
+    ``coarse_error`` and named in the cell; a second failure is not run a third time."""
+    calls = []
+    hi = study.NONLINEAR_LEVELS[-1]
+
+    def fake(cp, sv, se, m, keep_path=False, steps=study.NONLINEAR_STEPS):
+        calls.append((m, steps))
+        failed = m == hi and steps == study.NONLINEAR_STEPS
+        return {"m": m, "membrane": study.MEMBRANE, "n_dof": 10, "first_increment": 1.0 / steps,
+                "instability_load_factor": None, "instability_estimate": None,
+                "instability_bracket": None, "limit_load_factor": None, "stop": "load_factor",
+                "load_factor_reached": 1.0, "events": [], "time_s": 1.0,
+                "error": "arc-length increment 14 did not converge at load factor 0.769834"
+                if failed else ""}  # fmt: skip
+
+    monkeypatch.setattr(study, "nonlinear_level", fake)
+    rows = study.nonlinear("pleats", 90.0, [], lambda rows: None)
+    assert calls[-1] == (hi, study.FINE_STEPS)
+    fine = rows[-1]
+    assert fine["coarse_error"].startswith("arc-length") and fine["error"] == ""
+    assert study._inst(fine) == f"stable to 1 (1/{study.NONLINEAR_STEPS}: failed at 0.770)"
+    again = dict(fine, error="no convergence")
+    assert not study.needs_second_look(again)  # already from 1/40
