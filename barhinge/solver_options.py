@@ -92,6 +92,13 @@ class SolverOptions:
         GMRES iterations per solve before a fresh factorisation is made instead.
     arc_length_increment : float or None
         Load-factor increment of the first arc-length (MGDCM) step; default ``1/steps``.
+    arc_max_load_increment : float or None
+        Largest change of the load factor in one arc-length increment. MGDCM keeps a
+        generalised arc length, so on a path that stiffens (a soft start, an imperfect
+        shell) one increment can climb far: an increment that climbs more is redone shorter,
+        and later increments keep the shorter length until they climb less than half of it.
+        The stability of the path is then sampled at least every this much load. Default
+        None (no cap).
     max_arc_steps : int or None
         Cap on arc-length increments (default ``10 * steps``); a run that reaches it before
         one of its stop criteria raises :class:`~barhinge.errors.ConvergenceError`.
@@ -146,6 +153,7 @@ class SolverOptions:
     reuse_factorization: bool = False
     krylov_max: int = 30
     arc_length_increment: float | None = None
+    arc_max_load_increment: float | None = None
     max_arc_steps: int | None = None
     arc_stop_load_factor: float | None = None
     arc_stop_displacement: dict[str, Any] | None = None
@@ -193,6 +201,8 @@ class SolverOptions:
             num("augmentation", 0.0, lo_open=False)
         if self.arc_length_increment is not None:
             num("arc_length_increment", 0.0)
+        if self.arc_max_load_increment is not None:
+            num("arc_max_load_increment", 0.0)
         if self.max_arc_steps is not None:
             whole("max_arc_steps", 1, MAX_ARC_STEPS)
         if self.arc_stop_load_factor is not None:

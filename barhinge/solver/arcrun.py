@@ -81,6 +81,8 @@ def run_arc_length(d: ArcDriver, progress: Progress | None) -> FoldPath:
     n = 0
     limit_points = 0
     prev_dlam = 0.0
+    cap = o.arc_max_load_increment
+    shorter = 1.0  # arc length kept shorter after an increment climbed past ``cap``
     stop: dict[str, Any] | None = None
     while stop is None and n < max_steps:
         n += 1
@@ -96,21 +98,36 @@ def run_arc_length(d: ArcDriver, progress: Progress | None) -> FoldPath:
         if o.arc_stop_instability and _lost_stability(d.records[0].neg, d.records[-1].neg):
             stop = {"criterion": "instability", "value": float(st.lam)}
             break
-        scale = dl0
+        scale = dl0 * shorter
         last: IncrementFailed | None = None
         for _cut in range(o.max_cutbacks + 1):
             try:
                 new, e_new, res, tan, sgn = arc_increment(
                     ctx, d.conv, st, e, scale, first_tan, prev_tan, sign, factored
                 )
-                break
             except IncrementFailed as f:
                 factored = False
                 scale /= 2
                 last = f
+                continue
+            climb = abs(new.lam - st.lam)
+            if cap is None or climb <= cap * (1.0 + 1e-9):
+                break
+            # climbed past the cap: redo it shorter (and keep that length)
+            factored = False
+            scale *= 0.9 * cap / climb
+            last = IncrementFailed(
+                f"the load factor climbs {climb:.3g} in one increment, more than "
+                f"arc_max_load_increment = {cap:g}",
+                res,
+            )
         else:
             assert last is not None
             raise d.fail(n, st.lam, last.why, last.residuals)
+        if cap is not None:
+            shorter = scale / dl0
+            if abs(new.lam - st.lam) < 0.5 * cap:
+                shorter = min(1.0, 1.5 * shorter)
         if first_tan is None:
             first_tan = tan
         prev_tan, sign = tan, sgn

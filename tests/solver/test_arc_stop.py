@@ -202,3 +202,33 @@ def test_a_leap_far_past_the_stop_lands_in_sub_steps():
     w = -ref.X[-1][:, 2].min()
     assert w > 100 * model.material.t  # deep in the membrane regime
     np.testing.assert_allclose(arc.X[-1], ref.X[-1], atol=1e-8 * w)
+
+
+def test_load_increment_cap_samples_a_stiffening_path():
+    """Pulled upwards, the truss stiffens (the bars stretch, ``P ~ z^3``), so MGDCM's
+    increments climb ever more load (0.17 .. 0.36 of it from a first 0.1); with
+    ``arc_max_load_increment = 0.1`` no increment climbs more, every state still lies on the
+    closed-form curve, and the path ends at the same load factor 1 and apex height."""
+    model, S, apex = von_mises_model()
+    P = np.zeros((model.n_nodes, 3))
+    P[apex, 2] = 20.0 * P_MAX  # upwards
+
+    def path(**opts):
+        sc = Scene(model, supports=S, loads=P, control="arc_length", steps=10,
+                   options={"max_arc_steps": 400, **opts})  # fmt: skip
+        return bh.solve(sc)
+
+    free = path()
+    capped = path(arc_max_load_increment=0.1)
+    assert np.abs(np.diff(free.load_factor)).max() > 0.2
+    assert np.abs(np.diff(capped.load_factor)).max() <= 0.1 * (1 + 1e-9)
+    assert capped.load_factor[-1] == pytest.approx(1.0, abs=1e-12)
+    z = capped.X[:, apex, 2]
+    np.testing.assert_allclose(-capped.load_factor * 20.0 * P_MAX, p_closed_form(z), atol=1e-8)
+    assert z[-1] == pytest.approx(free.X[-1, apex, 2], abs=1e-9)
+
+
+@pytest.mark.parametrize("bad", [0.0, -0.1, float("inf")])
+def test_load_increment_cap_must_be_positive(bad):
+    with pytest.raises(ConfigError, match="arc_max_load_increment"):
+        SolverOptions(arc_max_load_increment=bad)
