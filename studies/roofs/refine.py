@@ -27,8 +27,9 @@ one-facet check (docs/roofs.csv, which ``run.py`` writes). The ranking written w
 uses the refined stiffness and buckling factor and the finest nonlinear check.
 
 Run: ``python studies/roofs/refine.py [--quick] [--publish] [--cache=FILE]
-[--only=FAMILY,...]`` (``--only`` computes those families' roofs into the cache and
-publishes nothing: two such runs with their own caches use two cores). Every level
+[--only=FAMILY,...] [--no-second-look]`` (``--only`` computes those families' roofs into the
+cache and publishes nothing: two such runs with their own caches use two cores;
+``--no-second-look`` runs no check again from the finer increment). Every level
 is written to the cache as soon as it is computed (default ``refine_cache.json`` beside this
 file, not versioned), so an interrupted run resumes where it stopped and ``--publish``
 re-derives the page from it. Importing the module runs the quick mode (two roofs, up to
@@ -82,6 +83,8 @@ NONLINEAR_LEVELS = (2, 4) if QUICK else (4, 8)
 #: from a stable state past the first critical point; the finer path is the one reported,
 #: with the coarse path's critical load factor beside it)
 NONLINEAR_STEPS, FINE_STEPS = 10, 40
+#: ``--no-second-look``: publish the cached checks as they are (no check is run again)
+SECOND_LOOK = "--no-second-look" not in sys.argv
 #: the shell reference of every roof (:func:`roofs.shell_level`, facet meshes graded towards
 #: the corners): these levels, then further until its Richardson estimate settles or the next
 #: level would exceed ``SHELL_DOF_BUDGET`` DOFs
@@ -184,7 +187,7 @@ def needs_second_look(row: dict) -> bool:
     """Whether a nonlinear check lost stability, or failed, on a first increment coarser
     than ``1 / FINE_STEPS`` (checks cached before ``first_increment`` was recorded used
     ``1 / NONLINEAR_STEPS``)."""
-    if not row.get("error") and critical(row) is None:
+    if not SECOND_LOOK or (not row.get("error") and critical(row) is None):
         return False
     return float(row.get("first_increment", 1.0 / NONLINEAR_STEPS)) > 1.0 / FINE_STEPS
 
