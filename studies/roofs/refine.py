@@ -756,6 +756,33 @@ def nonlinear_finding(results: list[dict], coarse: dict[str, dict[str, str]]) ->
                 else " No verdict changed."
             )
         )
+        moved = [
+            (r, x)
+            for r, x in looked
+            if critical(x) is not None and abs(critical(x) / x["coarse_critical"] - 1.0) > 0.05
+        ]
+
+        def listed(group: list) -> str:
+            return ", ".join(
+                f"{lab(r)} at m = {x['m']} ({critical(x):.3f}, was {x['coarse_critical']:.3f})"
+                for r, x in group
+            )
+
+        earlier = [(r, x) for r, x in moved if critical(x) < x["coarse_critical"]]
+        later = [(r, x) for r, x in moved if critical(x) > x["coarse_critical"]]
+        if earlier:
+            parts.append(
+                " The finer path loses stability more than 5 % earlier for "
+                + listed(earlier)
+                + ": the coarse increment stepped past the first critical point."
+            )
+        if later:
+            parts.append(
+                " It loses stability more than 5 % later for "
+                + listed(later)
+                + ": there the coarse first increment converged onto an equilibrium off the"
+                " path that the finer increments follow."
+            )
     for r, x in rescued:
         parts.append(
             f" The check of {lab(r)} at m = {x['m']} failed from 1/{NONLINEAR_STEPS} (at load"

@@ -340,3 +340,33 @@ def test_a_failed_check_gets_a_second_look_once(study, monkeypatch) -> None:
     assert study._inst(fine) == f"stable to 1 (1/{study.NONLINEAR_STEPS}: failed at 0.770)"
     again = dict(fine, error="no convergence")
     assert not study.needs_second_look(again)  # already from 1/40
+
+
+def test_finding_names_checks_the_finer_increment_moved(study) -> None:
+    """Finding 7 names the checks whose finer path loses stability more than 5 % earlier
+    (the coarse increment stepped past the critical point) or later (it converged off the
+    path), and the ones it turned."""
+    base = {"membrane": study.MEMBRANE, "n_dof": 10, "limit_load_factor": None, "error": "",
+            "stop": "instability", "instability_bracket": [0.1, 0.2], "time_s": 1.0,
+            "deflection_linear": 1.0, "deflection_nonlinear": 1.0,
+            "load_factor_reached": 0.2}  # fmt: skip
+
+    def check(m, crit, was):
+        return {**base, "m": m, "instability_load_factor": crit, "instability_estimate": crit,
+                "coarse_critical": was}  # fmt: skip
+
+    lo, hi = study.NONLINEAR_LEVELS
+    results = [
+        {"family": "a", "state": 1.0, "buckling_factor": 2.0,
+         "nonlinear": [check(lo, 0.30, 0.40), check(hi, 0.30, 0.40)]},
+        {"family": "b", "state": 2.0, "buckling_factor": 2.0,
+         "nonlinear": [check(lo, 0.50, 0.20), check(hi, 0.60, 0.61)]},
+        {"family": "c", "state": 3.0, "buckling_factor": 2.0,
+         "nonlinear": [check(lo, None, 0.25) | {"instability_estimate": None,
+                                                "stop": "load_factor"}, check(hi, 0.9, 0.9)]},
+    ]  # fmt: skip
+    text = study.nonlinear_finding(results, {})
+    assert f"a 1 at m = {hi} (0.300, was 0.400)" in text.split("earlier for")[1]
+    assert f"b 2 at m = {lo} (0.500, was 0.200)" in text.split("later for")[1]
+    assert f"b 2 at m = {hi} (" not in text  # 0.60 against 0.61: within 5 %
+    assert f"c 3 at m = {lo} (was 0.250) carry the design load" in text
