@@ -443,6 +443,8 @@ def sensitivity_section(rows: list[dict], perfect: dict[tuple[str, float], dict[
         [
             SENS_START,
             "",
+            "### Sensitivity: higher buckling modes and larger imperfections",
+            "",
             generated_stamp("python studies/roofs/imperfection.py --sensitivity --publish"),
             "",
             f"Data: [roofs_imperfect_sensitivity.csv](roofs_imperfect_sensitivity.csv). For"
