@@ -177,3 +177,20 @@ def test_the_example_scene_of_the_docs_folds():
     path = bh.solve(scene)
     assert path.converged and path.load_factor[-1] == pytest.approx(1.0)
     assert path.meta["imperfection"]["rule"] == "span/300"
+
+
+def test_span_needs_real_supports_and_a_length_needs_no_rule():
+    """``span/N`` on the automatic 3-2-1 restraint is refused (it has no span); a length is
+    used as given, and the summary line names no rule for it."""
+    from barhinge.output.summary import imperfection_text
+
+    m, _, P = _strip(3)
+    free = Scene(m, loads=P, control="load", imperfection=Imperfection(amplitude="span/300"))
+    assert free.auto_restrained
+    with pytest.raises(ConfigError, match="span/N' needs supports"):
+        amplitude_length(free)
+    given = free.with_(imperfection=Imperfection(amplitude=0.02))
+    assert amplitude_length(given) == 0.02
+    rec = {"mode": 1, "buckling_factor": 2.0, "amplitude": 0.02, "rule": None}
+    assert imperfection_text(rec) == "buckling mode 1 (factor 2), amplitude 0.02"
+    assert imperfection_text({**rec, "rule": "span/300"}).endswith("= span/300")
