@@ -263,11 +263,7 @@ def summary(rows: list[dict], perfect: dict[tuple[str, float], dict[str, str]]) 
         lost = [r for r in ok if critical(r) is not None]
         kept = [r for r in ok if critical(r) is None]
         failed = [r for r in mine if r["error"]]
-        grow = [
-            r["deflection_nonlinear"]
-            / float(perfect[(r["family"], float(r["state"]))]["deflection_nonlinear"])
-            for r in kept
-        ]
+        grow = [_growth(r, perfect) for r in kept]
         text = (
             f"- **w0 = {name}**: of the {len(mine)} roofs, {len(kept)} still carry the design"
             f" load and {len(lost)} {'loses' if len(lost) == 1 else 'lose'} stability below it"
@@ -349,6 +345,13 @@ def sensitivity_tasks() -> list[tuple[str, int]]:
     return [(n, k) for k in modes for n in AMPLITUDES] + [(n, 1) for n in SENSITIVITY_AMPLITUDES]
 
 
+def _growth(r: dict, perfect: dict[tuple[str, float], dict[str, str]]) -> float:
+    """The imperfect roof's largest deflection at the design load over the perfect roof's."""
+    return r["deflection_nonlinear"] / float(
+        perfect[(r["family"], float(r["state"]))]["deflection_nonlinear"]
+    )
+
+
 def _effect(r: dict, perfect: dict[tuple[str, float], dict[str, str]]) -> str:
     """A check as a cell: where stability is lost, or the deflection at the design load over
     the perfect roof's."""
@@ -357,10 +360,7 @@ def _effect(r: dict, perfect: dict[tuple[str, float], dict[str, str]]) -> str:
     c = critical(r)
     if c is not None:
         return f"loses stability at {c:.3f}"
-    ratio = r["deflection_nonlinear"] / float(
-        perfect[(r["family"], float(r["state"]))]["deflection_nonlinear"]
-    )
-    return f"× {ratio:.2f}"
+    return f"× {_growth(r, perfect):.2f}"
 
 
 def _severity(r: dict, perfect: dict[tuple[str, float], dict[str, str]]) -> float:
@@ -370,9 +370,7 @@ def _severity(r: dict, perfect: dict[tuple[str, float], dict[str, str]]) -> floa
     c = critical(r)
     if c is not None:
         return 10.0 - c
-    return r["deflection_nonlinear"] / float(
-        perfect[(r["family"], float(r["state"]))]["deflection_nonlinear"]
-    )
+    return _growth(r, perfect)
 
 
 def sensitivity_section(rows: list[dict], perfect: dict[tuple[str, float], dict[str, str]]) -> str:
