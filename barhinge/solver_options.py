@@ -58,13 +58,17 @@ class SolverOptions:
         bordered actuator system (exact: the term is compensated on the right-hand side).
         ``"auto"`` scales it to the tangent; 0 disables it.
     predictor : str
-        ``"quadratic"`` (default: Lagrange extrapolation through the last three converged
-        states; secant with two, tangent step for the first increment), ``"secant"``
-        (through the last two) or ``"tangent"`` (always a linearised step at the last
-        converged state). An increment whose extrapolated start fails is retried once with
-        the tangent predictor before it is cut back. On the Miura actuator benchmark the
-        quadratic predictor needs 2 corrections per step where the secant needs 3
-        (docs/solver-performance.md).
+        ``"polynomial"`` (default): extrapolation of coordinates and multipliers through
+        the last converged states (up to eight) of the degree they support
+        (:func:`barhinge.linalg.extrapolation.extrapolate`) or the quadratic through the last
+        three, whichever leaves the smaller residual (two force evaluations without the
+        tangent). ``"quadratic"``: Lagrange extrapolation through the last three converged
+        states. Both use the secant with two states and a tangent step for the first
+        increment. ``"secant"``: through the last two. ``"tangent"``: always a linearised
+        step at the last converged state. An increment whose extrapolated start fails is
+        retried once with the tangent predictor before it is cut back. On a smooth path the
+        polynomial start is close enough that most steps take one Newton correction
+        (docs/solver-performance.md, the predictor table).
     line_search : int
         Maximum halvings of a Newton correction in the backtracking line search on
         ``|r|^2 + (s c)^2`` (0 = plain Newton, the default: on stiff-bar / soft-fold
@@ -147,7 +151,7 @@ class SolverOptions:
     divergence_ratio: float = 1e4
     linear_solver: str = "auto"
     augmentation: float | str = "auto"
-    predictor: str = "quadratic"
+    predictor: str = "polynomial"
     line_search: int = 0
     acceleration: bool = False
     reuse_factorization: bool = False
@@ -185,7 +189,9 @@ class SolverOptions:
         whole("max_cutbacks", 0, 60)
         whole("line_search", 0, 60)
         _check.choice(self.linear_solver, "options.linear_solver", LINEAR_SOLVERS)
-        _check.choice(self.predictor, "options.predictor", ("quadratic", "secant", "tangent"))
+        _check.choice(
+            self.predictor, "options.predictor", ("polynomial", "quadratic", "secant", "tangent")
+        )
         _check.choice(self.flat_start, "options.flat_start", ("rigid", "tangent"))
         _check.boolean(self.reuse_factorization, "options.reuse_factorization")
         _check.boolean(self.acceleration, "options.acceleration")

@@ -16,9 +16,10 @@ quasi-rigid of the Newton factorisations (all less the inertia ones, which both 
 once per state) and of the wall time (issue 19 asks for at most 2). The figures come
 from ``FoldPath.meta["newton"]`` and ``meta["timing"]``.
 
-A second table runs every size and set again with the other setting of the geodesic
-acceleration of the Newton corrections (option ``acceleration``) and gives the ratio of
-iterations, Newton factorisations and wall time, accelerated / plain.
+Two more tables run every size and set again with the other setting of the geodesic
+acceleration of the Newton corrections (option ``acceleration``) and of the predictor
+(option ``predictor``: quadratic or polynomial) and give the ratios of Newton
+factorisations and wall time.
 """
 
 from __future__ import annotations
@@ -29,9 +30,12 @@ import logging
 import statistics
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import barhinge as bh
+from barhinge.solver_options import SolverOptions
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_solver import miura_scene  # noqa: E402
@@ -133,30 +137,62 @@ def main() -> None:
     out("|---|---|---|")
     for n, rf, rw in ratios:
         out(f"| {n} | {rf:.2f} | {rw:.2f} |")
-    accelerated = bool(options.get("acceleration", False))
-    out()
-    out("### Geodesic acceleration (option `acceleration`): plain and accelerated Newton")
-    out(
-        "| n | material | iterations plain / accelerated | accelerated corrections | "
-        "Newton factorisations plain / accelerated | wall s plain / accelerated | "
-        "ratio of Newton factorisations | ratio of wall time |"
-    )
-    out("|---|---|---|---|---|---|---|---|")
-    for n, rows in all_rows:
-        for material, r in rows.items():
-            other = [run(n, material, a.steps, {**options, "acceleration": not accelerated})
-                     for _ in range(a.repeat)]  # fmt: skip
-            o = dict(other[-1])
-            o["wall"] = statistics.median(x["wall"] for x in other)
-            p, q = (o, r) if accelerated else (r, o)  # plain, accelerated
-            fp, fa = p["fact"] - p["inertia"], q["fact"] - q["inertia"]
-            out(
-                f"| {n} | {material} | {p['iterations']} / {q['iterations']} | "
-                f"{q['accelerated']} | {fp} / {fa} | {p['wall']:.2f} / {q['wall']:.2f} | "
-                f"{fa / fp:.2f} | {q['wall'] / p['wall']:.2f} |"
-            )
+    runs_of = {(n, m): r for n, rows in all_rows for m, r in rows.items()}
+    compare(
+        out, runs_of, a, options, "acceleration", (False, True),
+        "Geodesic acceleration (option `acceleration`): plain and accelerated Newton",
+        ("plain", "accelerated"),
+    )  # fmt: skip
+    compare(
+        out, runs_of, a, options, "predictor", ("quadratic", "polynomial"),
+        "Predictor (option `predictor`): the quadratic and the polynomial of the degree the "
+        "path supports",
+        ("quadratic", "polynomial"),
+    )  # fmt: skip
     if a.publish:
         publish(lines, a)
+
+
+def compare(
+    out: Callable[..., None],
+    runs_of: dict[tuple[int, str], dict],
+    a: argparse.Namespace,
+    options: dict,
+    key: str,
+    values: tuple[Any, Any],
+    title: str,
+    labels: tuple[str, str],
+) -> None:
+    """A table of every size and set run with both ``values`` of option ``key``: iterations,
+    Newton factorisations (the inertia ones left out), failed increments, wall time and the
+    ratios second / first. The runs of the main table are reused for the value it ran with."""
+    ran_with = options.get(key, getattr(SolverOptions(), key))
+    one, two = labels
+    out()
+    out(f"### {title}")
+    out(
+        f"| n | material | iterations {one} / {two} | Newton factorisations {one} / {two} | "
+        f"failed incr. {one} / {two} | wall s {one} / {two} | ratio of Newton factorisations | "
+        "ratio of wall time |"
+    )
+    out("|---|---|---|---|---|---|---|---|")
+    for (n, material), r in runs_of.items():
+        pair = []
+        for v in values:
+            if v == ran_with:
+                pair.append(r)
+                continue
+            other = [run(n, material, a.steps, {**options, key: v}) for _ in range(a.repeat)]
+            o = dict(other[-1])
+            o["wall"] = statistics.median(x["wall"] for x in other)
+            pair.append(o)
+        p, q = pair
+        fp, fq = p["fact"] - p["inertia"], q["fact"] - q["inertia"]
+        out(
+            f"| {n} | {material} | {p['iterations']} / {q['iterations']} | {fp} / {fq} | "
+            f"{p['failed']} / {q['failed']} | {p['wall']:.2f} / {q['wall']:.2f} | "
+            f"{fq / fp:.2f} | {q['wall'] / p['wall']:.2f} |"
+        )
 
 
 def publish(lines: list[str], a: argparse.Namespace) -> None:

@@ -45,6 +45,7 @@ import scipy.sparse.linalg as spla
 
 from barhinge.actuators import Actuators
 from barhinge.errors import ConfigError, ConvergenceError
+from barhinge.linalg.extrapolation import EXTRAPOLATION_POINTS, extrapolate
 from barhinge.kinematics.constraints import RigidConstraints
 from barhinge.kinematics.dof import FLAT_TOL, _branch_direction
 from barhinge.linalg.backends import Factor, SingularMatrixError, get_backend
@@ -60,8 +61,6 @@ log = logging.getLogger(__name__)
 
 #: crease variables from which the corrector uses the fastest backend instead of SuperLU
 PARDISO_MIN_VARS = 5000
-#: converged states the predictor extrapolates through (at most; see :func:`_extrapolate`)
-EXTRAPOLATION_POINTS = 8
 
 
 @dataclasses.dataclass(frozen=True)
@@ -694,42 +693,6 @@ def _normal_diagonal(J: sp.csr_matrix) -> np.ndarray:
     return np.bincount(J.indices, weights=J.data * J.data, minlength=J.shape[1])
 
 
-def _extrapolate(hist: list[tuple[float, np.ndarray]], s_new: float) -> np.ndarray | None:
-    """Polynomial extrapolation of the last converged states to the path parameter ``s_new``,
-    of the degree the states support; None with fewer than three states.
-
-    ``P_k`` interpolates the last ``k`` states (Lagrange form; error O(h^k) on a smooth
-    path) and ``e_k = |P_{k+1} - P_k|`` estimates its error. The lowest ``k`` whose estimate
-    is within twice the smallest is refined once and ``P_{k+1}`` returned: a smooth path
-    uses all its states (up to EXTRAPOLATION_POINTS), a corner of a control curve a few
-    states back stops the degree before the corner (the estimates stop falling there). On
-    a 70 x 70 Miura sheet folded in 30 steps the predicted closure residual falls from
-    ~1e-5 (cubic) to ~1e-8, so that one Newton iteration per step reaches the tolerance
-    instead of two (docs/kinematics.md, *Performance*)."""
-    if len(hist) < 3:
-        return None
-    ss = [p[0] for p in hist]
-    if len(set(ss)) < len(ss):
-        return None
-    preds = [_lagrange(hist[-k:], s_new) for k in range(2, len(hist) + 1)]
-    errors = np.array([np.max(np.abs(b - a)) for a, b in zip(preds[:-1], preds[1:], strict=True)])
-    best = int(np.flatnonzero(errors <= 2.0 * errors.min())[0])
-    return preds[best + 1]
-
-
-def _lagrange(pts: list[tuple[float, np.ndarray]], s_new: float) -> np.ndarray:
-    """Value at ``s_new`` of the polynomial through the points (s_i, rho_i)."""
-    ss = [p[0] for p in pts]
-    out = np.zeros_like(pts[0][1])
-    for i, (si, ri) in enumerate(pts):
-        li = 1.0
-        for j, sj in enumerate(ss):
-            if j != i:
-                li *= (s_new - sj) / (si - sj)
-        out += li * ri
-    return out
-
-
 def _as_actuators(actuators: Actuators | Sequence[int], targets_deg) -> Actuators:
     if isinstance(actuators, Actuators):
         if targets_deg is not None:
@@ -1027,7 +990,7 @@ def _predict(
     if flat:
         guess = solver.leave_flat(cur, b)
     elif not check_misfit:
-        guess = _extrapolate(track, s_new)
+        guess = extrapolate(track, s_new)
     if guess is None:
         guess, misfit = solver.tangent(cur, b - a)
         if misfit > 1e-6 and opt.check_actuators and not solver.soft:

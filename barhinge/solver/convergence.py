@@ -4,6 +4,8 @@ forcing term of an inexact (GMRES) solve, and the backtracking line search on th
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from barhinge.solver.context import SolveContext
@@ -42,25 +44,40 @@ class Convergence:
         eta = min(1e-3, max(rf / fref, 0.1 * need / bnorm))
         return max(eta, 1e-13)
 
-    def converged(self, e: Evaluation, st: State, dx: np.ndarray, res: list[float]) -> bool:
+    def converged(
+        self,
+        e: Evaluation,
+        st: State,
+        dx: np.ndarray,
+        res: list[float],
+        next_correction: Callable[[], np.ndarray] | None = None,
+    ) -> bool:
         """Whether the iterate ``st`` passes the force, displacement (``dx``: the last
-        correction) and actuator-angle tests (``res``: force residual norms so far)."""
+        correction) and actuator-angle tests (``res``: force residual norms so far).
+
+        The displacement test also passes when the residual contracted so fast that the
+        next correction should be below the tolerance (``|dx| q / (1 - q)`` with ``q`` the
+        last contraction, or ``q < 1e-3``). ``next_correction`` (a back-substitution of the
+        current residual with the last factorisation) then confirms it: along a soft mode a
+        residual at the force floor can still hide a correction far above the tolerance (an
+        imperfect strut near its buckling load)."""
         ctx = self.ctx
         o = ctx.opts
         rf = float(np.linalg.norm(e.r[ctx.free]))
         self.tol_abs = o.tol_force * self.force_ref(e, st) + ctx.floor
         ok_f = rf <= self.tol_abs
-        ok_x = float(np.linalg.norm(dx)) <= o.tol_disp * ctx.size
-        if not ok_x and len(res) >= 2 and rf < 1e-3 * res[-2]:
-            ok_x = True
-        if not ok_x and ok_f and len(res) >= 2 and rf <= 0.5 * res[-2]:
-            # contracting iteration (ratio q): the remaining error is at most about
-            # |dx| q / (1 - q) (linear rate; less in the quadratic regime). Saves the
-            # confirming iterations at the round-off floor of the force residual.
-            q = rf / res[-2]
-            ok_x = float(np.linalg.norm(dx)) * q / (1 - q) <= o.tol_disp * ctx.size
         ok_c = (not ctx.n_act) or float(np.max(np.abs(e.c))) <= o.tol_angle
-        return bool(ok_f and ok_x and ok_c)
+        tol_x = o.tol_disp * ctx.size
+        ok_x = float(np.linalg.norm(dx)) <= tol_x
+        if ok_x or not (ok_f and ok_c) or len(res) < 2 or not res[-2] > 0:
+            return bool(ok_f and ok_x and ok_c)
+        q = rf / res[-2]
+        # contracting iteration (ratio q): the remaining error is at most about
+        # |dx| q / (1 - q) (linear rate; less in the quadratic regime)
+        by_rate = q < 1e-3 or (q <= 0.5 and float(np.linalg.norm(dx)) * q / (1 - q) <= tol_x)
+        if by_rate and next_correction is not None:
+            by_rate = float(np.linalg.norm(next_correction())) <= tol_x
+        return bool(by_rate)
 
     def merit(self, e: Evaluation) -> float:
         """``|r_free|^2 + (s c)^2``, force^2."""

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from barhinge.errors import ConfigError, ConvergenceError
+from barhinge.linalg.extrapolation import EXTRAPOLATION_POINTS, extrapolate, lagrange
 from barhinge.linalg.threads import threads_for_sparse
 from barhinge.results import FoldPath, Interrupted
 from barhinge.solver.arcrun import run_arc_length
@@ -86,6 +87,9 @@ class _Driver:
         self.work = WorkIntegrator(ctx.P, ctx.fixed)
         self._prev: State | None = None
         self._prev2: State | None = None
+        # converged states (t, [x, mu]) of the polynomial predictor, the last EXTRAPOLATION_POINTS
+        self._hist: list[tuple[float, np.ndarray]] = []
+        self._pred_eval: Evaluation | None = None  # the predictor's evaluation, if it made one
         self._retry_tangent = False  # next increment: tangent predictor (after a failure)
         self.n_iter_last = 0  # Newton corrections of the last converged increment
         self.inertia = InertiaMonitor(ctx)
@@ -111,9 +115,10 @@ class _Driver:
         free = self.free
         res: list[float] = []
         self.system.inertia_seen = []
+        self._pred_eval = None
         new = self._predict(st, t1, lam1, res)
         x_pred = new.x.copy()
-        e = ctx.evaluate(new)
+        e = self._pred_eval if self._pred_eval is not None else ctx.evaluate(new)
         dx_last: np.ndarray | None = None
         n_iter = 0
         while True:
@@ -122,7 +127,11 @@ class _Driver:
             ctx.timer.n_iterations += 1
             if not np.isfinite(rf) or not np.all(np.isfinite(e.c)):
                 raise IncrementFailed("non-finite residual", res)
-            if dx_last is not None and self.conv.converged(e, new, dx_last, res):
+
+            def next_correction(e: Evaluation = e) -> np.ndarray:
+                return self.system.solve(-e.r[free], -e.c)[0]
+
+            if dx_last is not None and self.conv.converged(e, new, dx_last, res, next_correction):
                 self.n_iter_last = n_iter
                 self.inertia.check_inertia(res)
                 self.inertia.check_jump(st, x_pred, new, res)
@@ -167,6 +176,30 @@ class _Driver:
         self.ctx.timer.n_accelerated += 1
         return dx + 0.5 * a, dmu + 0.5 * amu
 
+    def _polynomial(self, st: State, t1: float, lam1: float) -> State:
+        """Predictor ``"polynomial"``: the extrapolation of the last converged states of the
+        degree they support (:func:`barhinge.linalg.extrapolation.extrapolate`) or the quadratic
+        through the last three, whichever has the smaller residual ``|r_free|^2 + (s c)^2``
+        (two force evaluations without the tangent; the chosen one is kept for the first
+        iteration). Near a bifurcation or a change of branch the high degree can overshoot
+        where the quadratic does not."""
+        ctx, nx = self.ctx, len(st.x)
+        cands = [lagrange(self._hist[-3:], t1)]
+        z = extrapolate(self._hist, t1)
+        if z is not None and not np.array_equal(z, cands[0]):
+            cands.insert(0, z)
+        best: tuple[float, State, Evaluation] | None = None
+        for z in cands:
+            new = State(z[:nx].copy(), z[nx:].copy(), lam1, t1)
+            new.x[self.fixed] = ctx.fixed_coords(t1)
+            e = ctx.evaluate(new, tangent=False)
+            m = self.conv.merit(e)
+            if best is None or m < best[0]:
+                best = (m, new, e)
+        assert best is not None
+        self._pred_eval = best[2]
+        return best[1]
+
     def _expects_convergence(self, res: list[float]) -> bool:
         return self.conv.expects_convergence(res)
 
@@ -177,14 +210,16 @@ class _Driver:
         free, fixed = self.free, self.fixed
         prev = self._prev
         prev2 = self._prev2
-        extrapolate = o.predictor in ("secant", "quadratic") and not self._retry_tangent
+        extrapolate = o.predictor != "tangent" and not self._retry_tangent
         guided = None
         if self.flat.active and not self._retry_tangent:
             guided = self.flat.prediction(st, t1, lam1)
         if guided is not None:
             return guided
         if prev is not None and prev.t < st.t and extrapolate:
-            if o.predictor == "quadratic" and prev2 is not None and prev2.t < prev.t:
+            if o.predictor == "polynomial" and len(self._hist) >= 3:
+                return self._polynomial(st, t1, lam1)
+            if o.predictor != "secant" and prev2 is not None and prev2.t < prev.t:
                 # Lagrange extrapolation through the last three converged states
                 ta, tb, tc = prev2.t, prev.t, st.t
                 la = (t1 - tb) * (t1 - tc) / ((ta - tb) * (ta - tc))
@@ -287,6 +322,7 @@ class _Driver:
         steps = self.scene.steps
         st, e = self.initial()
         self.record(st, e, 0, [], neg=self.inertia.tangent_inertia(st, e, exact=True))
+        self._hist.append((st.t, np.concatenate([st.x, st.mu])))
         e_new = e
         h0 = 1.0 / steps
         h = h0
@@ -322,6 +358,8 @@ class _Driver:
                 self.work.add(self.records[0], new, e_new, None)
                 critical = ""
                 self._prev2, self._prev, st = self._prev, st, new
+                self._hist.append((new.t, np.concatenate([new.x, new.mu])))
+                del self._hist[:-EXTRAPOLATION_POINTS]
                 self.inertia.inertia = self.system.negative_pivots
                 iters += self.n_iter_last
                 n_inc += 1

@@ -163,7 +163,8 @@ def test_force_only_evaluation_when_convergence_is_expected_changes_nothing(monk
     assert light.meta["timing"]["n_force_only"] > 0
     monkeypatch.setattr(newton._Driver, "_expects_convergence", lambda self, res: False)
     full = bh.solve(scene)
-    assert full.meta["timing"]["n_force_only"] == 0
+    # the polynomial predictor's own force-only evaluations remain (two candidates compared)
+    assert full.meta["timing"]["n_force_only"] < light.meta["timing"]["n_force_only"]
     np.testing.assert_array_equal(light.X, full.X)
     np.testing.assert_array_equal(light.actuator_moments, full.actuator_moments)
     assert light.residual_norms == full.residual_norms
