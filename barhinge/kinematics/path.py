@@ -45,10 +45,10 @@ import scipy.sparse.linalg as spla
 
 from barhinge.actuators import Actuators
 from barhinge.errors import ConfigError, ConvergenceError
-from barhinge.linalg.extrapolation import EXTRAPOLATION_POINTS, extrapolate
 from barhinge.kinematics.constraints import RigidConstraints
 from barhinge.kinematics.dof import FLAT_TOL, _branch_direction
 from barhinge.linalg.backends import Factor, SingularMatrixError, get_backend
+from barhinge.linalg.extrapolation import EXTRAPOLATION_POINTS, extrapolate
 from barhinge.linalg.nullspace import DENSE_TOL, null_space
 from barhinge.linalg.threads import threads_for_sparse
 from barhinge.pattern.crease import CreasePattern
