@@ -73,16 +73,20 @@ class SolverOptions:
         Maximum halvings of a Newton correction in the backtracking line search on
         ``|r|^2 + (s c)^2`` (0 = plain Newton, the default: on stiff-bar / soft-fold
         mechanisms full Newton steps with cut-back of the increment were measured faster).
-    acceleration : bool
-        Geodesic acceleration of every Newton correction (Transtrum & Sethna 2012,
+    acceleration : bool or "auto"
+        Geodesic acceleration of Newton corrections (Transtrum & Sethna 2012,
         arXiv:1201.5885): the second directional derivative of the residual along the step
         ``v``, ``r'' = (r(x + h v) + r(x - h v) - 2 r(x)) / h^2`` (two force evaluations,
         no tangent), is solved with the step's factorisation, and the step becomes
         ``v + a / 2`` when ``2 |a| <= |v|``. Along a near-mechanism the plain step leaves
         the curved valley of the soft mode and stretches the bars (the next iterate's
-        residual jumps); the corrected step follows the valley to second order. Off by
-        default; on the Miura benchmarks it saves Newton factorisations, the more the
-        softer the sheet (docs/solver-performance.md, the acceleration table). Not used
+        residual jumps); the corrected step follows the valley to second order.
+        ``"auto"`` (default): the corrections of an increment are accelerated once its
+        residual has risen from one iterate to the next (the near-mechanism's signature),
+        and every correction of an increment that follows one which failed or needed more
+        than ``AUTO_ACCELERATION_AFTER`` corrections; plain Newton elsewhere, so a stiff
+        sheet pays nothing. ``True``: every correction; ``False``: none.
+        docs/solver-performance.md, the acceleration table, measures all three. Not used
         under arc length.
     reuse_factorization : bool
         Reuse a factorisation over Newton iterations and increments as the preconditioner
@@ -153,7 +157,7 @@ class SolverOptions:
     augmentation: float | str = "auto"
     predictor: str = "polynomial"
     line_search: int = 0
-    acceleration: bool = False
+    acceleration: bool | str = "auto"
     reuse_factorization: bool = False
     krylov_max: int = 30
     arc_length_increment: float | None = None
@@ -194,7 +198,8 @@ class SolverOptions:
         )
         _check.choice(self.flat_start, "options.flat_start", ("rigid", "tangent"))
         _check.boolean(self.reuse_factorization, "options.reuse_factorization")
-        _check.boolean(self.acceleration, "options.acceleration")
+        if self.acceleration != "auto":
+            _check.boolean(self.acceleration, "options.acceleration")
         _check.boolean(self.arc_stop_instability, "options.arc_stop_instability")
         if self.stability_check is not None:
             _check.boolean(self.stability_check, "options.stability_check")

@@ -16,10 +16,10 @@ quasi-rigid of the Newton factorisations (all less the inertia ones, which both 
 once per state) and of the wall time (issue 19 asks for at most 2). The figures come
 from ``FoldPath.meta["newton"]`` and ``meta["timing"]``.
 
-Two more tables run every size and set again with the other setting of the geodesic
-acceleration of the Newton corrections (option ``acceleration``) and of the predictor
-(option ``predictor``: quadratic or polynomial) and give the ratios of Newton
-factorisations and wall time.
+Two more tables run every size and set again with the other settings of the geodesic
+acceleration of the Newton corrections (option ``acceleration``: plain, auto, always) and
+of the predictor (option ``predictor``: quadratic or polynomial) and give the ratios of
+Newton factorisations and wall time to the first setting.
 """
 
 from __future__ import annotations
@@ -139,9 +139,10 @@ def main() -> None:
         out(f"| {n} | {rf:.2f} | {rw:.2f} |")
     runs_of = {(n, m): r for n, rows in all_rows for m, r in rows.items()}
     compare(
-        out, runs_of, a, options, "acceleration", (False, True),
-        "Geodesic acceleration (option `acceleration`): plain and accelerated Newton",
-        ("plain", "accelerated"),
+        out, runs_of, a, options, "acceleration", (False, "auto", True),
+        "Geodesic acceleration (option `acceleration`): plain Newton, accelerated where the "
+        "residual rose or after a hard increment (auto, the default), every correction",
+        ("plain", "auto", "always"),
     )  # fmt: skip
     compare(
         out, runs_of, a, options, "predictor", ("quadratic", "polynomial"),
@@ -159,40 +160,46 @@ def compare(
     a: argparse.Namespace,
     options: dict,
     key: str,
-    values: tuple[Any, Any],
+    values: tuple[Any, ...],
     title: str,
-    labels: tuple[str, str],
+    labels: tuple[str, ...],
 ) -> None:
-    """A table of every size and set run with both ``values`` of option ``key``: iterations,
-    Newton factorisations (the inertia ones left out), failed increments, wall time and the
-    ratios second / first. The runs of the main table are reused for the value it ran with."""
+    """A table of every size and set run with each of ``values`` of option ``key``:
+    iterations, Newton factorisations (the inertia ones left out), failed increments, wall
+    time, and the ratios of Newton factorisations and wall time of each later value to the
+    first. The runs of the main table are reused for the value it ran with."""
     ran_with = options.get(key, getattr(SolverOptions(), key))
-    one, two = labels
+    names = " / ".join(labels)
+    ratio_cols = [f"{lab} / {labels[0]}" for lab in labels[1:]]
     out()
     out(f"### {title}")
     out(
-        f"| n | material | iterations {one} / {two} | Newton factorisations {one} / {two} | "
-        f"failed incr. {one} / {two} | wall s {one} / {two} | ratio of Newton factorisations | "
-        "ratio of wall time |"
+        f"| n | material | iterations {names} | Newton factorisations {names} | "
+        f"failed incr. {names} | wall s {names} | "
+        + " | ".join(f"Newton factorisations {c} | wall {c}" for c in ratio_cols)
+        + " |"
     )
-    out("|---|---|---|---|---|---|---|---|")
+    out("|---|---|---|---|---|---|" + "---|---|" * len(ratio_cols))
     for (n, material), r in runs_of.items():
-        pair = []
+        row = []
         for v in values:
-            if v == ran_with:
-                pair.append(r)
+            if v == ran_with and type(v) is type(ran_with):
+                row.append(r)
                 continue
             other = [run(n, material, a.steps, {**options, key: v}) for _ in range(a.repeat)]
             o = dict(other[-1])
             o["wall"] = statistics.median(x["wall"] for x in other)
-            pair.append(o)
-        p, q = pair
-        fp, fq = p["fact"] - p["inertia"], q["fact"] - q["inertia"]
-        out(
-            f"| {n} | {material} | {p['iterations']} / {q['iterations']} | {fp} / {fq} | "
-            f"{p['failed']} / {q['failed']} | {p['wall']:.2f} / {q['wall']:.2f} | "
-            f"{fq / fp:.2f} | {q['wall'] / p['wall']:.2f} |"
-        )
+            row.append(o)
+        newton = [x["fact"] - x["inertia"] for x in row]
+        cells = [
+            " / ".join(str(x["iterations"]) for x in row),
+            " / ".join(str(f) for f in newton),
+            " / ".join(str(x["failed"]) for x in row),
+            " / ".join(f"{x['wall']:.2f}" for x in row),
+        ]
+        for x, f in zip(row[1:], newton[1:], strict=True):
+            cells += [f"{f / newton[0]:.2f}", f"{x['wall'] / row[0]['wall']:.2f}"]
+        out(f"| {n} | {material} | " + " | ".join(cells) + " |")
 
 
 def publish(lines: list[str], a: argparse.Namespace) -> None:

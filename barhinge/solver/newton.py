@@ -40,6 +40,9 @@ ACCELERATION_H = 0.5
 #: the acceleration is kept when |a| <= ACCELERATION_RATIO |v| (the step's second-order
 #: part small against its first-order part)
 ACCELERATION_RATIO = 0.5
+#: option acceleration "auto": an increment that needed more Newton corrections than this
+#: (or failed) has the next one accelerated from its first correction
+AUTO_ACCELERATION_AFTER = 2
 
 if TYPE_CHECKING:
     from barhinge.scene import Scene
@@ -89,6 +92,8 @@ class _Driver:
         self._prev2: State | None = None
         # converged states (t, [x, mu]) of the polynomial predictor, the last EXTRAPOLATION_POINTS
         self._hist: list[tuple[float, np.ndarray]] = []
+        # the last increment failed or needed many corrections (option acceleration "auto")
+        self._hard_last = False
         self._pred_eval: Evaluation | None = None  # the predictor's evaluation, if it made one
         self._retry_tangent = False  # next increment: tangent predictor (after a failure)
         self.n_iter_last = 0  # Newton corrections of the last converged increment
@@ -133,6 +138,7 @@ class _Driver:
 
             if dx_last is not None and self.conv.converged(e, new, dx_last, res, next_correction):
                 self.n_iter_last = n_iter
+                self._hard_last = n_iter > AUTO_ACCELERATION_AFTER
                 self.inertia.check_inertia(res)
                 self.inertia.check_jump(st, x_pred, new, res)
                 return new, e, res
@@ -148,7 +154,7 @@ class _Driver:
             n_iter += 1
             rtol = self.conv.forcing(e, new, rf)
             dx, dmu = self.system.solve(-e.r[free], -e.c, rtol=rtol)
-            if o.acceleration:
+            if self._accelerate(res):
                 dx, dmu = self._accelerated(new, e, dx, dmu, rtol)
             light = self._expects_convergence(res)
             new, e, alpha = self.conv.line_search(new, e, dx, dmu, light)
@@ -199,6 +205,15 @@ class _Driver:
         assert best is not None
         self._pred_eval = best[2]
         return best[1]
+
+    def _accelerate(self, res: list[float]) -> bool:
+        """Whether the next correction is accelerated (option ``acceleration``): always,
+        never, or ("auto") once the increment's residual has risen or after a hard
+        increment."""
+        a = self.opts.acceleration
+        if a != "auto":
+            return bool(a)
+        return self._hard_last or any(b > a for a, b in zip(res, res[1:], strict=False))
 
     def _expects_convergence(self, res: list[float]) -> bool:
         return self.conv.expects_convergence(res)
@@ -344,6 +359,7 @@ class _Driver:
                         "step %d: increment to t=%.6g failed (%s); cutting back", s, t1, f.why
                     )
                     n_failed += 1
+                    self._hard_last = True
                     critical = self.inertia.failure_text(f.why) or critical
                     if self._retry(st):
                         continue

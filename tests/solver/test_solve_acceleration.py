@@ -16,7 +16,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 from bench_solver import miura_scene  # noqa: E402
 
 
-def _solve(n: int, material: str, acceleration: bool, steps: int = 50):
+def _solve(n: int, material: str, acceleration: bool | str, steps: int = 50):
     sc = miura_scene(n, 0.0, steps, material=material)
     return bh.solve(sc.with_(options={**sc.options.__dict__, "acceleration": acceleration}))
 
@@ -26,6 +26,15 @@ def compliant_pair():
     logging.disable(logging.WARNING)  # the compliant sheet's stability events
     try:
         return _solve(10, "compliant", False), _solve(10, "compliant", True)
+    finally:
+        logging.disable(logging.NOTSET)
+
+
+@pytest.fixture(scope="module")
+def compliant_auto():
+    logging.disable(logging.WARNING)
+    try:
+        return _solve(10, "compliant", "auto")
     finally:
         logging.disable(logging.NOTSET)
 
@@ -60,6 +69,35 @@ def test_acceleration_saves_corrections_on_a_near_mechanism(compliant_pair) -> N
     assert n_acc <= 0.9 * n_plain
     assert acc.meta["timing"]["n_accelerated"] > 0
     assert plain.meta["timing"]["n_accelerated"] == 0
+
+
+def test_auto_acceleration_reaches_the_same_path_with_fewer_factorisations(
+    compliant_pair, compliant_auto
+) -> None:
+    """``acceleration = "auto"`` (the default) accelerates only where the residual rose or
+    after a hard increment: on the compliant sheet the same energies as plain Newton (1e-9
+    relative) and fewer factorisations, with some but not all corrections accelerated."""
+    plain, _ = compliant_pair
+    auto = compliant_auto
+    e = [np.asarray(p.energy_bars) + np.asarray(p.energy_bend) + np.asarray(p.energy_fold)
+         for p in (plain, auto)]  # fmt: skip
+    assert np.abs(e[1] - e[0]).max() <= 1e-9 * e[0].max()
+    assert auto.meta["negative_eigenvalues"] == plain.meta["negative_eigenvalues"]
+    assert auto.meta["timing"]["n_factorizations"] < plain.meta["timing"]["n_factorizations"]
+    n_acc = auto.meta["timing"]["n_accelerated"]
+    assert 0 < n_acc < auto.meta["newton"]["total_iterations"]
+
+
+def test_auto_acceleration_leaves_a_stiff_smooth_fold_plain() -> None:
+    """On the quasi-rigid sheet the steps past the flat start converge without a rising
+    residual: "auto" accelerates at most as many corrections as the first ten steps made,
+    and ends where plain Newton ends, within the displacement tolerance (1e-8 of the
+    sheet's size)."""
+    auto = _solve(6, "quasi-rigid", "auto", steps=30)
+    plain = _solve(6, "quasi-rigid", False, steps=30)
+    assert auto.meta["timing"]["n_accelerated"] <= sum(auto.meta["newton"]["iterations"][:10])
+    size = float(np.ptp(plain.X[0], axis=0).max())
+    assert np.abs(auto.X[-1] - plain.X[-1]).max() <= 1e-8 * size
 
 
 def test_acceleration_option_is_checked() -> None:
