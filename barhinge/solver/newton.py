@@ -210,10 +210,11 @@ class _Driver:
         """Whether the next correction is accelerated (option ``acceleration``): always,
         never, or ("auto") once the increment's residual has risen or after a hard
         increment."""
-        a = self.opts.acceleration
-        if a != "auto":
-            return bool(a)
-        return self._hard_last or any(b > a for a, b in zip(res, res[1:], strict=False))
+        mode = self.opts.acceleration
+        if mode != "auto":
+            return bool(mode)
+        rose = any(later > earlier for earlier, later in zip(res, res[1:], strict=False))
+        return self._hard_last or rose
 
     def _expects_convergence(self, res: list[float]) -> bool:
         return self.conv.expects_convergence(res)
