@@ -5,6 +5,8 @@ and the stop criteria read from the options (:func:`displacement_stop`,
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from barhinge.errors import ConfigError
@@ -49,6 +51,7 @@ def arc_increment(
     dx = dlam * u_hat + u_bar
     new.x[free] += dx
     tan1 = u_hat
+    uh = u_hat  # K^-1 P of the factorisation at hand
     it = 1
     while True:
         e = ctx.evaluate(new)
@@ -57,7 +60,7 @@ def arc_increment(
         ctx.timer.n_iterations += 1
         if not np.isfinite(rf):
             raise IncrementFailed("non-finite residual", res)
-        if it > 1 and conv.converged(e, new, dx, res):
+        if it > 1 and conv.converged(e, new, dx, res, _arc_correction(ctx, e, uh, tan1)):
             return new, e, res, tan1, sgn
         if it >= o.max_iter:
             raise IncrementFailed(f"no convergence in {o.max_iter} iterations", res)
@@ -70,6 +73,32 @@ def arc_increment(
         new.mu = new.mu + dl * mh + mb
         new.lam += dl
         it += 1
+
+
+def _arc_correction(
+    ctx: SolveContext, e: Evaluation, uh: np.ndarray, tan1: np.ndarray
+) -> Callable[[], np.ndarray]:
+    """The next arc-length correction from the residual of ``e`` with the factorisation at
+    hand (``uh = K^-1 P`` of it), for :meth:`Convergence.converged` to confirm a state
+    accepted by the residual's rate."""
+
+    def correction() -> np.ndarray:
+        ub, _ = ctx.system.solve(-e.r[ctx.free], -e.c)
+        return -float(tan1 @ ub) / float(tan1 @ uh) * uh + ub
+
+    return correction
+
+
+def _landing_correction(
+    ctx: SolveContext, e: Evaluation, uh: np.ndarray, k: int
+) -> Callable[[], np.ndarray]:
+    """The next correction of :func:`land_displacement` (free component ``k`` held)."""
+
+    def correction() -> np.ndarray:
+        ub, _ = ctx.system.solve(-e.r[ctx.free], -e.c)
+        return -float(ub[k]) / float(uh[k]) * uh + ub if uh[k] != 0.0 else ub
+
+    return correction
 
 
 def land_displacement(
@@ -93,6 +122,7 @@ def land_displacement(
     zc = np.zeros(ctx.n_act)
     res: list[float] = []
     dx = np.zeros(int(free.sum()))
+    uh = np.zeros_like(dx)  # K^-1 P of the factorisation at hand (from the first correction)
     why = f"no convergence in {o.max_iter} iterations"
     for it in range(1, o.max_iter + 1):
         e = ctx.evaluate(new)
@@ -102,7 +132,7 @@ def land_displacement(
         if not np.isfinite(rf):
             why = "non-finite residual"
             break
-        if it > 1 and conv.converged(e, new, dx, res):
+        if it > 1 and conv.converged(e, new, dx, res, _landing_correction(ctx, e, uh, k)):
             return new, e, res
         try:
             ctx.factorize(e, new)
