@@ -67,12 +67,23 @@ def arc_increment(
         ctx.factorize_or_fail(e, new, res)
         uh, mh = ctx.system.solve(e.P[free], zc)
         ub, mb = ctx.system.solve(-e.r[free], -e.c)
-        dl = -float(tan1 @ ub) / float(tan1 @ uh)
+        dl = _arc_dlam(ub, uh, tan1)
         dx = dl * uh + ub
         new.x[free] += dx
         new.mu = new.mu + dl * mh + mb
         new.lam += dl
         it += 1
+
+
+def _arc_dlam(ub: np.ndarray, uh: np.ndarray, tan1: np.ndarray) -> float:
+    """Load-factor correction of an MGDCM corrector: the correction ``dl uh + ub`` stays
+    orthogonal to the increment's first tangent ``tan1`` (Leon et al. 2011)."""
+    return -float(tan1 @ ub) / float(tan1 @ uh)
+
+
+def _landing_dlam(ub: np.ndarray, uh: np.ndarray, k: int) -> float:
+    """Load-factor correction that holds free component ``k`` of ``dl uh + ub`` at 0."""
+    return -float(ub[k]) / float(uh[k])
 
 
 def _arc_correction(
@@ -84,7 +95,7 @@ def _arc_correction(
 
     def correction() -> np.ndarray:
         ub, _ = ctx.system.solve(-e.r[ctx.free], -e.c)
-        return -float(tan1 @ ub) / float(tan1 @ uh) * uh + ub
+        return _arc_dlam(ub, uh, tan1) * uh + ub
 
     return correction
 
@@ -96,7 +107,7 @@ def _landing_correction(
 
     def correction() -> np.ndarray:
         ub, _ = ctx.system.solve(-e.r[ctx.free], -e.c)
-        return -float(ub[k]) / float(uh[k]) * uh + ub if uh[k] != 0.0 else ub
+        return _landing_dlam(ub, uh, k) * uh + ub if uh[k] != 0.0 else ub
 
     return correction
 
@@ -144,7 +155,7 @@ def land_displacement(
         if uh[k] == 0.0:
             why = "the load does not move the stopping component"
             break
-        dl = -float(ub[k]) / float(uh[k])
+        dl = _landing_dlam(ub, uh, k)
         dx = dl * uh + ub
         new.x[free] += dx
         new.mu = new.mu + dl * mh + mb
