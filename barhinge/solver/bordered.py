@@ -43,6 +43,7 @@ import scipy.sparse.linalg as spla
 
 from barhinge._protocols import SolverModel
 from barhinge.linalg.backends import LinearBackend, SingularMatrixError
+from barhinge.linalg.inertia import InertiaCounter
 
 __all__ = ["ActuatorTerms", "BorderedSystem", "Timer", "actuator_terms", "hinge_derivatives"]
 
@@ -239,7 +240,7 @@ class BorderedSystem:
         # released tangent's inertia; a backend of its own keeps that factor apart
         self._penalty_blocks: np.ndarray | None = None
         self._released: tuple[np.ndarray, np.ndarray] | None = None
-        self._released_backend: LinearBackend | None = None
+        self._released_counter: InertiaCounter | None = None
 
     # ---------------------------------------------------------------- structure
     def _prepare(self, K: sp.csr_matrix) -> None:
@@ -509,7 +510,9 @@ class BorderedSystem:
     def _released_inertia(self) -> int | None:
         """Negative eigenvalues of the released tangent ``K_t = A - p G^T G`` of the last
         bordered factorisation, from a factorisation of ``K_t`` itself (a backend of its
-        own, so the bordered factor stays alive); None when its backend gives no inertia."""
+        own, so the bordered factor stays alive: Cholesky while the released tangents are
+        positive definite, :class:`~barhinge.linalg.inertia.InertiaCounter`); None when its
+        backend gives no inertia."""
         assert self._released is not None and self._blk_pos is not None
         assert self._sel is not None and self._sub_indptr is not None
         data, pen = self._released
@@ -517,18 +520,18 @@ class BorderedSystem:
         np.add.at(released, self._blk_pos, -pen.ravel())
         nf = len(self.free_idx)
         Kt = sp.csr_matrix((released[self._sel], self._sub_indices, self._sub_indptr), (nf, nf))
-        if self._released_backend is None:
-            self._released_backend = type(self.backend)()
+        if self._released_counter is None:
+            self._released_counter = InertiaCounter(self.backend)
+        counter = self._released_counter
+        made = counter.factorizations
         t0 = time.perf_counter()
         try:
-            factor = self._released_backend.factorize(Kt)
+            return counter.negative_eigenvalues(Kt)
         except SingularMatrixError:
             return None
         finally:
             self.timer.factorize += time.perf_counter() - t0
-            self.timer.n_factorizations += 1
-        neg = getattr(factor, "negative_pivots", None)
-        return neg() if neg is not None else None
+            self.timer.n_factorizations += counter.factorizations - made
 
     # ---------------------------------------------------------------- solve
     def solve(
