@@ -32,9 +32,9 @@ class SolverOptions:
         and ``force_floor``.
     tol_disp : float
         Relative displacement tolerance: ``|dx| <= tol_disp * size`` (``size`` = the model's
-        bounding-box diagonal) on the last correction. It is also taken as met when the
-        force residual fell by more than ``1e3`` in the last iteration (quadratic regime:
-        the next correction would be far below the tolerance).
+        bounding-box diagonal) on the last correction. Where the force and actuator tests
+        pass and the last correction is larger, it is met by the next correction (one
+        back-substitution of the residual with the last factorisation) instead.
     tol_angle : float
         Absolute tolerance on the actuator constraints ``|rho_a - rho_target|`` (radians).
     force_floor : float or None

@@ -22,7 +22,7 @@ import numpy as np
 
 from barhinge._json import jsonable
 from barhinge.errors import ConfigError
-from barhinge.output.fields import path_state_data, write_state_vtu, write_xdmf
+from barhinge.output.fields import StateData, path_state_data, write_state_vtu, write_xdmf
 from barhinge.output.folder import MANIFEST, result_folder
 from barhinge.output.summary import run_summary, stop_reason, summary_rows
 from barhinge.output.table import step_table, write_step_table
@@ -128,10 +128,18 @@ def _write(
     summary = jsonable({**run_summary(fold_path, scene), "results": results}, nan=False)
     written["json"] = out / SUMMARY
     written["json"].write_text(json.dumps(summary, indent=2) + "\n")
-    written["csv"] = write_step_table(out / STEPS, step_table(fold_path, model=model, pattern=cp))
+    # the fields of every state, once for the step table and the field files
+    states: list[StateData] | None = None
+    if fields:
+        try:
+            states = path_state_data(fold_path, model=model, pattern=cp)
+        except Exception as exc:  # noqa: BLE001 - the fields are an extra; keep the run
+            log.warning("fields not written: %s", exc)
+    rows = step_table(fold_path, model=model, pattern=cp, states=states)
+    written["csv"] = write_step_table(out / STEPS, rows)
     try:
         marks = {"fixed": fixed, "loads": loads}
-        written.update(_extras(fold_path, model, cp, out, name, vtu, fields, pictures, marks))
+        written.update(_extras(fold_path, model, cp, out, name, vtu, states, pictures, marks))
     except Exception as exc:  # noqa: BLE001 - an optional extra must not lose the solved path
         log.warning("fields and pictures not all written: %s", exc)
     return written, summary
@@ -173,15 +181,15 @@ def _buckling(model: Any, scene: Any, folder: Path | None) -> dict[str, Any]:
     return rec
 
 
-def _extras(fold_path, model, cp, out: Path, name: str, vtu: str, fields: bool, pictures: str,
-            marks: dict[str, Any]):  # fmt: skip
-    """FOLD frames, then (``fields``) XDMF and VTU files, then pictures (``"png"``: the final
-    state and the charts; ``"all"``: and the energy-density picture and the GIF)."""
+def _extras(fold_path, model, cp, out: Path, name: str, vtu: str,
+            states: list[StateData] | None, pictures: str, marks: dict[str, Any]):  # fmt: skip
+    """FOLD frames, then (``states``: the fields of every state) XDMF and VTU files, then
+    pictures (``"png"``: the final state and the charts; ``"all"``: and the energy-density
+    picture and the GIF)."""
     from barhinge.pattern.fold import write_fold_path
 
     written: dict[str, Path] = {"fold": write_fold_path(cp, fold_path, out / f"{name}.fold")}
-    if fields:
-        states = path_state_data(fold_path, model=model, pattern=cp)  # once, for both files
+    if states is not None:
         written["xdmf"] = write_xdmf(out / f"{name}.xdmf", fold_path, states=states)
         written["xdmf_bars"] = out / f"{name}_bars.xdmf"
         n = fold_path.n_states
