@@ -57,6 +57,21 @@ def test_lumped_energy_is_the_stored_energy(run):
     np.testing.assert_allclose(dm.moment[-1, model.hinge_edge[h]], expect, rtol=1e-9, atol=1e-15)
 
 
+def test_run_writer_view_from_its_states_is_the_view_read_back(run):
+    """The run writer hands the viewer the fields it wrote instead of reading its VTU files
+    back: the view is the same."""
+    from barhinge.output.fields import path_state_data
+
+    scene, path, out = run
+    states = path_state_data(path, model=scene.model, pattern=scene.model.pattern)
+    given = load_view_data(out, pattern=scene.model.pattern, states=states)
+    read = load_view_data(out)
+    np.testing.assert_array_equal(given.energy_density, read.energy_density)
+    np.testing.assert_array_equal(given.triangles, read.triangles)
+    np.testing.assert_array_equal(given.bars, read.bars)
+    np.testing.assert_array_equal(given.bar_L0, read.bar_L0)
+
+
 def test_file_is_small_and_self_contained(run):
     _, _, out = run
     html = viewer_html(out)

@@ -104,8 +104,9 @@ def _write(
     fixed: Any | None,
     loads: Any | None,
     results: dict | None,
-) -> tuple[dict[str, Path], dict[str, Any]]:
-    """The files of one path, written straight into ``out``; (files by kind, summary)."""
+) -> tuple[dict[str, Path], dict[str, Any], list[StateData] | None]:
+    """The files of one path, written straight into ``out``; (files by kind, summary, the
+    fields of every state when written)."""
     if vtu not in ("all", "last", "none"):
         raise ConfigError(f"vtu = {vtu!r}; expected 'all', 'last' or 'none'")
     model, cp = _mesh_source(fold_path, model, pattern)
@@ -142,7 +143,7 @@ def _write(
         written.update(_extras(fold_path, model, cp, out, name, vtu, states, pictures, marks))
     except Exception as exc:  # noqa: BLE001 - an optional extra must not lose the solved path
         log.warning("fields and pictures not all written: %s", exc)
-    return written, summary
+    return written, summary, states
 
 
 def _forces(fold_path: FoldPath, scene: Any) -> dict[str, Any]:
@@ -257,7 +258,7 @@ def write_results(
     dict from a file kind (``npz``, ``json``, ``csv``, ``fold``, ``xdmf``, ``xdmf_bars``,
     ``vtu``: the last one written, and the picture kinds) to its path.
     """
-    files, _ = _write(fold_path, model, Path(out_dir), pattern=pattern, name=name, scene=None,
+    files, _, _ = _write(fold_path, model, Path(out_dir), pattern=pattern, name=name, scene=None,
                       vtu=vtu, fields=True, pictures=picture_level(pictures), npz=npz,
                       fixed=fixed,
                       loads=loads, results=results)  # fmt: skip
@@ -314,13 +315,13 @@ def write_run(
     level = picture_level(pictures)
     model = scene.model
     with result_folder(out_dir, overwrite=overwrite, command=command) as run:
-        _, summary = _write(fold_path, model, run.path, pattern=model.pattern,
+        _, summary, states = _write(fold_path, model, run.path, pattern=model.pattern,
                                   name="fold_path", scene=scene, vtu="all", fields=fields,
                                   pictures=level if fields else "none", npz=True,
                                   fixed=getattr(scene, "fixed", None),
                                   loads=getattr(scene, "loads", None), results=None)  # fmt: skip
         if viewer:
-            _write_viewer(run.path, model.pattern)
+            _write_viewer(run.path, model.pattern, states)
         run.manifest.update(
             scene=summary["scene"],
             kind=fold_path.kind,
@@ -336,14 +337,15 @@ def write_run(
     return RunOutput(out, files, summary, summary_rows(summary, fold_path))
 
 
-def _write_viewer(folder: Path, pattern: Any) -> Path | None:
+def _write_viewer(folder: Path, pattern: Any, states: list[StateData] | None) -> Path | None:
     """``viewer.html`` of the result folder being written (``pattern``: the crease pattern
-    of its ``fold_path.fold``); a warning (not a failure) if it cannot be made: the solved
-    path is never lost for a picture."""
+    of its ``fold_path.fold``; ``states``: the fields of its VTU files, not read back); a
+    warning (not a failure) if it cannot be made: the solved path is never lost for a
+    picture."""
     from barhinge.view import write_viewer
 
     try:
-        return write_viewer(folder, folder / VIEWER, pattern=pattern)
+        return write_viewer(folder, folder / VIEWER, pattern=pattern, states=states)
     except Exception as exc:  # noqa: BLE001 - the viewer is an extra; keep the run
         log.warning("viewer not written: %s", exc)
         return None

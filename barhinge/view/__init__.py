@@ -44,8 +44,9 @@ def write_viewer(
         :data:`~barhinge.view.html.QUANTISE_ABOVE` node-states.
     **kwargs
         ``model``, ``scene``, ``pattern``, ``fixed``, ``loads``, ``title`` for a FoldPath;
-        ``pattern`` for a result folder (the crease pattern of its ``fold_path.fold``, which
-        is then not read back).
+        ``pattern`` and ``states`` for a result folder (the crease pattern of its
+        ``fold_path.fold`` and the :class:`~barhinge.output.fields.StateData` of its VTU
+        files, which are then not read back).
 
     Returns
     -------

@@ -332,9 +332,12 @@ def _without_pattern(path: FoldPath, title: str | None) -> ViewData:
     )
 
 
-def _from_folder(folder: Path, pattern: Any | None = None) -> ViewData:
-    """The view of a result folder; ``pattern``: the crease pattern its ``fold_path.fold``
-    holds, when the caller has it (the run writer: reading the frames back is skipped)."""
+def _from_folder(
+    folder: Path, pattern: Any | None = None, states: list[StateData] | None = None
+) -> ViewData:
+    """The view of a result folder; ``pattern`` and ``states``: the crease pattern its
+    ``fold_path.fold`` holds and the fields of its VTU files, when the caller has them (the
+    run writer: reading them back is skipped)."""
     npz = folder / "fold_path.npz"
     if not npz.is_file():
         raise ConfigError(f"{folder} has no fold_path.npz: not a result folder of barhinge fold")
@@ -343,8 +346,9 @@ def _from_folder(folder: Path, pattern: Any | None = None) -> ViewData:
     if not fold.is_file():
         raise ConfigError(f"{folder} has no fold_path.fold (the crease pattern of the path)")
     cp = pattern if pattern is not None else read_fold(fold, validate=False)
-    vtus = [folder / f"fold_path_{s:04d}.vtu" for s in range(path.n_states)]
-    states = [read_state_vtu(f) for f in vtus] if all(f.is_file() for f in vtus) else None
+    if states is None or len(states) != path.n_states:
+        vtus = [folder / f"fold_path_{s:04d}.vtu" for s in range(path.n_states)]
+        states = [read_state_vtu(f) for f in vtus] if all(f.is_file() for f in vtus) else None
     summary: dict[str, Any] = {}
     js = folder / "summary.json"
     if js.is_file():
@@ -391,7 +395,7 @@ def load_view_data(source: Any, **kwargs: Any) -> ViewData:
         return view_data(source, **kwargs)
     p = Path(source)
     if p.is_dir():
-        return _from_folder(p, kwargs.get("pattern"))
+        return _from_folder(p, kwargs.get("pattern"), kwargs.get("states"))
     if not p.exists():
         raise ConfigError(f"{p} does not exist")
     if p.suffix == ".npz":
