@@ -34,6 +34,7 @@ import scipy.sparse.linalg as spla
 
 from barhinge.errors import ConfigError
 from barhinge.model.material import Material
+from barhinge.pattern.subdivide import corner_graded
 
 __all__ = [
     "polygon_mesh",
@@ -107,8 +108,7 @@ def graded_points(
         L = np.column_stack([lam, 1.0 - lam.sum(axis=1)])
         inside = (L > -1e-9 * scale).all(axis=1) & ~done
         Lin = np.clip(L[inside], 0.0, 1.0)
-        a, b = Lin**grading, (1.0 - Lin) ** grading
-        G = a / (a + b)
+        G = corner_graded(Lin, grading)
         is_corner = tri < k
         if is_corner.all():
             G /= G.sum(axis=1, keepdims=True)

@@ -7,6 +7,13 @@ lines inside a face are ``F`` at fold angle 0. The pattern's vertices keep their
 (``0 .. n_vertices - 1``); the state is unchanged (the same surface, more lines), so a
 bar-and-hinge model of the subdivided pattern resolves the panels' own bending and
 stretching ``m`` times finer.
+
+With ``grading`` ``p > 1`` the grid lines crowd towards the panels' corners, where the
+stresses of a folded plate concentrate (corners of supported edges, crease ends): every grid
+coordinate ``x = i/m`` (and every barycentric coordinate of a triangle's grid, renormalised)
+becomes ``g(x) = x^p / (x^p + (1 - x)^p)`` (:func:`corner_graded`). ``g(1 - x) = 1 - g(x)``, so
+an edge is cut at the same points from either end and neighbouring faces share them; the
+shell reference of :mod:`barhinge.model.shell` grades its facet meshes the same way.
 """
 
 from __future__ import annotations
@@ -16,11 +23,20 @@ import numpy as np
 from barhinge.errors import PatternError
 from barhinge.pattern.crease import CreasePattern
 
-__all__ = ["subdivided", "subdivided_size"]
+__all__ = ["corner_graded", "subdivided", "subdivided_size"]
 
 
-def subdivided(cp: CreasePattern, m: int) -> tuple[CreasePattern, np.ndarray]:
-    """The pattern ``cp`` with every face cut ``m`` times along each side (module docstring).
+def corner_graded(x: np.ndarray, grading: float) -> np.ndarray:
+    """``x^p / (x^p + (1 - x)^p)`` with ``p = grading``: points of [0, 1] moved towards its
+    ends (``p = 1``: unchanged); symmetric, ``g(1 - x) = 1 - g(x)``."""
+    x = np.asarray(x, float)
+    a, b = x**grading, (1.0 - x) ** grading
+    return a / (a + b)
+
+
+def subdivided(cp: CreasePattern, m: int, grading: float = 1.0) -> tuple[CreasePattern, np.ndarray]:
+    """The pattern ``cp`` with every face cut ``m`` times along each side (module docstring;
+    ``grading`` >= 1 crowds the cuts towards the faces' corners, 1: equal cuts).
 
     Returns
     -------
@@ -31,6 +47,8 @@ def subdivided(cp: CreasePattern, m: int) -> tuple[CreasePattern, np.ndarray]:
     """
     if not isinstance(m, (int, np.integer)) or m < 1:
         raise PatternError(f"subdivision m = {m!r}; expected an integer >= 1")
+    if not grading >= 1.0:
+        raise PatternError(f"subdivision grading = {grading!r}; expected a number >= 1")
     if m == 1:
         return cp, np.full(cp.n_vertices, -1, np.int64)
     V = np.asarray(cp.vertices3d, float)
@@ -44,7 +62,7 @@ def subdivided(cp: CreasePattern, m: int) -> tuple[CreasePattern, np.ndarray]:
     base = nv
     for e, (a, b) in enumerate(E):
         lo, hi = min(a, b), max(a, b)
-        s = np.arange(1, m)[:, None] / m
+        s = corner_graded(np.arange(1, m)[:, None] / m, grading)
         pts.append((1 - s) * V[lo] + s * V[hi])
         pedge.append(np.full(m - 1, e, np.int64))
         edge_pts[e] = np.concatenate([[lo], base + np.arange(m - 1), [hi]])
@@ -68,7 +86,7 @@ def subdivided(cp: CreasePattern, m: int) -> tuple[CreasePattern, np.ndarray]:
             g[m, :] = on_edge(F[1], F[2])
             g[:, m] = on_edge(F[3], F[2])
             g[0, :] = on_edge(F[0], F[3])
-            s = np.arange(1, m) / m
+            s = corner_graded(np.arange(1, m) / m, grading)
             S, T = np.meshgrid(s, s, indexing="ij")
             P = V[F]
             X = (
@@ -100,7 +118,8 @@ def subdivided(cp: CreasePattern, m: int) -> tuple[CreasePattern, np.ndarray]:
             inner = [(i, j) for i in range(1, m) for j in range(1, m - i)]
             for i, j in inner:
                 idx[(i, j)] = base
-                pts.append((P[0] + i / m * (P[1] - P[0]) + j / m * (P[2] - P[0]))[None])
+                bary = corner_graded(np.array([m - i - j, i, j]) / m, grading)
+                pts.append(((bary / bary.sum()) @ P)[None])
                 pedge.append(np.array([-1], np.int64))
                 base += 1
             for i in range(m):

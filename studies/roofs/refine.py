@@ -27,8 +27,10 @@ one-facet check (docs/roofs.csv, which ``run.py`` writes). The ranking written w
 uses the refined stiffness and buckling factor and the finest nonlinear check.
 
 Run: ``python studies/roofs/refine.py [--quick] [--publish] [--cache=FILE]
-[--only=FAMILY,...] [--no-second-look]`` (``--only`` computes those families' roofs into the
-cache and publishes nothing: two such runs with their own caches use two cores;
+[--only=FAMILY,...] [--no-second-look] [--grading=P]`` (``--grading``: sub-panels crowded
+towards the panels' corners, ``p >= 1``, as the shell reference's facet meshes; ``--only``
+computes those families' roofs into the cache and publishes nothing: two such runs with their
+own caches use two cores;
 ``--no-second-look`` runs no check again from the finer increment). Every level
 is written to the cache as soon as it is computed (default ``refine_cache.json`` beside this
 file, not versioned), so an interrupted run resumes where it stopped and ``--publish``
@@ -70,6 +72,10 @@ TOL = roofs.REFINE_TOL
 RULE = "coupled"
 #: its membrane (``bar_calibration``): cached levels of another membrane are recomputed
 MEMBRANE = roofs.BENDING_RULES[RULE].get("bar_calibration", "fit")
+#: sub-panels crowded towards the panels' corners (``--grading=P``; 1: equal sub-panels;
+#: :func:`barhinge.pattern.subdivide.subdivided`): cached levels of another grading are
+#: recomputed
+GRADING = float(next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--grading=")), 1))
 #: no level above this many DOFs is run
 DOF_BUDGET = 16_000 if QUICK else roofs.REFINE_DOF_BUDGET
 #: sub-panels per panel side, tried in order
@@ -117,7 +123,7 @@ def level(cp, sv: np.ndarray, se: np.ndarray, m: int) -> dict[str, Any]:
     from barhinge.scene import self_weight
 
     t0 = time.perf_counter()
-    model, S, residual = roofs.subdivided_roof(cp, sv, se, m, RULE)
+    model, S, residual = roofs.subdivided_roof(cp, sv, se, m, RULE, grading=GRADING)
     Fq = roofs.plan_load(model, roofs.Q)
     U, R = linear_response(model, Fq, S)
     Qt = float(-Fq[:, 2].sum())
@@ -131,6 +137,7 @@ def level(cp, sv: np.ndarray, se: np.ndarray, m: int) -> dict[str, Any]:
     return {
         "m": m,
         "membrane": MEMBRANE,
+        "grading": GRADING,
         "n_dof": 3 * model.n_nodes,
         "stiffness": Qt**2 / float(np.sum(Fq * U)),
         "plan_area": Qt / roofs.Q,
@@ -244,10 +251,13 @@ def change(rows: list[dict]) -> float:
 def refine(fam: str, state: float, done: list[dict], save=lambda rows: None) -> list[dict]:
     """The levels of one roof: ``done`` (cached) extended until the stiffness changes by less
     than ``TOL`` or the next level would exceed ``DOF_BUDGET``; ``save`` is called after every
-    new level. Cached levels of another membrane than ``MEMBRANE`` are not used."""
+    new level. Cached levels of another membrane than ``MEMBRANE`` or another grading than
+    ``GRADING`` are not used."""
     cp, flat_xy, _ = roofs.folded(fam, state)
     sv, se = roofs.support_lines(cp, flat_xy, roofs.FAMILIES[fam]["axis"])
-    rows = [r for r in done if r.get("membrane", "fit") == MEMBRANE]
+    rows = [
+        r for r in done if r.get("membrane", "fit") == MEMBRANE and r.get("grading", 1.0) == GRADING
+    ]
     rows = rows if len(rows) == len(done) else []
     for m in LEVELS[len(rows) :]:
         if roofs.settled([r["stiffness"] for r in rows], TOL):
@@ -1046,7 +1056,13 @@ def section(results: list[dict]) -> str:
             " `studies/roofs/refine_cache.json` as it is computed, so an interrupted run"
             " resumes; data: [roofs_refined.csv](roofs_refined.csv))."
             f" Every roof of the comparison table with each panel cut into m × m sub-panels"
-            f" (`{RULE}` plate rule, `{MEMBRANE}` membrane), m = 1, 2, 4, … until the"
+            f" (`{RULE}` plate rule, `{MEMBRANE}` membrane"
+            + (
+                f", sub-panels graded towards the panels' corners with p = {GRADING:g}"
+                if GRADING != 1.0
+                else ""
+            )
+            + "), m = 1, 2, 4, … until the"
             f" stiffness changes by less than {100 * TOL:g} % between two levels (a change"
             " of the same sign as the one before and smaller), or up to"
             f" {DOF_BUDGET:,} DOFs. Stiffness and width as in the comparison table (uniform"

@@ -507,7 +507,7 @@ def shell_extended(
 
 def subdivided_roof(
     cp, sv: np.ndarray, se: np.ndarray, m: int, rule: str = "coupled", scheme: str = "N5B8",
-    sheet: Any = None,
+    sheet: Any = None, grading: float = 1.0,
 ) -> tuple[Any, np.ndarray, float]:  # fmt: skip
     """A roof's bar-and-hinge model with every panel cut into ``m x m`` sub-panels.
 
@@ -518,6 +518,8 @@ def subdivided_roof(
     m : sub-panels per panel side (1: the panels as they are)
     rule : a key of ``BENDING_RULES``
     sheet : Material, the sheet (default: the study's, :func:`material`)
+    grading : sub-panels crowded towards the panels' corners (1: equal;
+        :func:`barhinge.pattern.subdivide.subdivided`)
 
     Returns
     -------
@@ -533,7 +535,7 @@ def subdivided_roof(
 
     if rule not in BENDING_RULES:
         raise ValueError(f"bending rule {rule!r}; expected one of {sorted(BENDING_RULES)}")
-    cpm, parent = subdivided(cp, m)
+    cpm, parent = subdivided(cp, m, grading)
     mat = material() if sheet is None else sheet
     model = bh.BarHingeModel.from_pattern(cpm, scheme, mat, **BENDING_RULES[rule])
     residual = 0.0

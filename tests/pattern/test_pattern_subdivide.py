@@ -7,7 +7,7 @@ import pytest
 
 import barhinge as bh
 from barhinge.errors import PatternError
-from barhinge.pattern.subdivide import subdivided, subdivided_size
+from barhinge.pattern.subdivide import corner_graded, subdivided, subdivided_size
 
 
 def _area(cp) -> float:
@@ -24,8 +24,9 @@ def _area(cp) -> float:
     ids=["quads", "triangles"],
 )
 @pytest.mark.parametrize("m", [2, 3])
-def test_subdivision_keeps_surface_creases_and_ids(cp, m):
-    out, parent = subdivided(cp, m)
+@pytest.mark.parametrize("grading", [1.0, 2.5])
+def test_subdivision_keeps_surface_creases_and_ids(cp, m, grading):
+    out, parent = subdivided(cp, m, grading)
     assert out.n_faces == m * m * cp.n_faces
     assert _area(out) == pytest.approx(_area(cp), rel=1e-12)
     np.testing.assert_array_equal(np.asarray(out.vertices3d)[: cp.n_vertices], cp.vertices3d)
@@ -84,3 +85,40 @@ def test_subdivision_keeps_a_non_developable_pattern_non_developable():
     out, _ = subdivided(pyramid, 2)
     assert out.developable is False
     assert _area(out) == pytest.approx(_area(pyramid), rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "cp",
+    [bh.families.miura(2, 2, fold=50.0), bh.families.yoshimura(3, 2, fold=20.0)],
+    ids=["quads", "triangles"],
+)
+def test_graded_subdivision_cuts_every_edge_at_the_graded_points(cp):
+    m, p = 4, 2.0
+    out, parent = subdivided(cp, m, grading=p)
+    X, V, E = np.asarray(out.vertices3d), np.asarray(cp.vertices3d), np.asarray(cp.edges)
+    expect = np.sort(corner_graded(np.arange(1, m) / m, p))
+    for e in range(cp.n_edges):
+        a, b = V[E[e, 0]], V[E[e, 1]]
+        on = X[parent == e]
+        s = np.sort((on - a) @ (b - a) / ((b - a) @ (b - a)))
+        np.testing.assert_allclose(s, expect, atol=1e-12)  # the same from either end
+    # the sub-faces at a panel's corner are smaller than those at its middle
+    area = np.array(
+        [0.5 * np.linalg.norm(np.cross(X[list(f)], np.roll(X[list(f)], -1, 0)).sum(0))
+         for f in out.faces]
+    )  # fmt: skip
+    corner = [k for k, f in enumerate(out.faces) if any(v < cp.n_vertices for v in f)]
+    middle = [k for k, f in enumerate(out.faces) if all(parent[v] < 0 and v >= cp.n_vertices
+                                                        for v in f)]  # fmt: skip
+    assert area[corner].max() < area[middle].min()
+
+
+def test_corner_grading_is_symmetric_and_fixes_the_ends():
+    x = np.linspace(0.0, 1.0, 11)
+    for p in (1.0, 2.0, 3.5):
+        g = corner_graded(x, p)
+        np.testing.assert_allclose(g + corner_graded(1.0 - x, p), 1.0, atol=1e-15)
+        assert g[0] == 0.0 and g[-1] == 1.0 and np.all(np.diff(g) > 0)
+    np.testing.assert_allclose(corner_graded(x, 1.0), x, atol=1e-15)
+    with pytest.raises(PatternError, match="grading"):
+        subdivided(bh.families.miura(1, 1, fold=30.0), 2, grading=0.5)
