@@ -8,12 +8,16 @@ lines inside a face are ``F`` at fold angle 0. The pattern's vertices keep their
 bar-and-hinge model of the subdivided pattern resolves the panels' own bending and
 stretching ``m`` times finer.
 
-With ``grading`` ``p > 1`` the grid lines crowd towards the panels' corners, where the
-stresses of a folded plate concentrate (corners of supported edges, crease ends): every grid
-coordinate ``x = i/m`` (and every barycentric coordinate of a triangle's grid, renormalised)
-becomes ``g(x) = x^p / (x^p + (1 - x)^p)`` (:func:`corner_graded`). ``g(1 - x) = 1 - g(x)``, so
-an edge is cut at the same points from either end and neighbouring faces share them; the
-shell reference of :mod:`barhinge.model.shell` grades its facet meshes the same way.
+With ``grading`` ``p > 1`` the grid lines of quadrilateral faces crowd towards their
+corners, where the stresses of a folded plate concentrate (corners of supported edges, crease
+ends): every grid coordinate ``x = i/m`` becomes ``g(x) = x^p / (x^p + (1 - x)^p)``
+(:func:`corner_graded`). ``g(1 - x) = 1 - g(x)``, so an edge is cut at the same points from
+either end and neighbouring faces share them; a parallelogram's cells stay parallelograms.
+The shell reference of :mod:`barhinge.model.shell` grades its facet meshes the same way.
+Triangles are not graded (a pattern with triangular faces and ``grading > 1`` is refused):
+a graded barycentric grid has cells of different shapes side by side, on which the coupled
+plate rule (:func:`barhinge.model.plate_hinges.coupled_bending`) no longer passes its patch
+test (a graded Yoshimura roof came out twice as stiff as its refined limit).
 """
 
 from __future__ import annotations
@@ -36,7 +40,8 @@ def corner_graded(x: np.ndarray, grading: float) -> np.ndarray:
 
 def subdivided(cp: CreasePattern, m: int, grading: float = 1.0) -> tuple[CreasePattern, np.ndarray]:
     """The pattern ``cp`` with every face cut ``m`` times along each side (module docstring;
-    ``grading`` >= 1 crowds the cuts towards the faces' corners, 1: equal cuts).
+    ``grading`` >= 1 crowds the cuts of quadrilateral faces towards their corners, 1: equal
+    cuts).
 
     Returns
     -------
@@ -49,6 +54,11 @@ def subdivided(cp: CreasePattern, m: int, grading: float = 1.0) -> tuple[CreaseP
         raise PatternError(f"subdivision m = {m!r}; expected an integer >= 1")
     if not grading >= 1.0:
         raise PatternError(f"subdivision grading = {grading!r}; expected a number >= 1")
+    if grading != 1.0 and any(len(f) != 4 for f in cp.faces):
+        raise PatternError(
+            f"subdivision grading = {grading!r} applies to quadrilateral faces only; this "
+            "pattern has other faces (subdivide it with grading = 1)"
+        )
     if m == 1:
         return cp, np.full(cp.n_vertices, -1, np.int64)
     V = np.asarray(cp.vertices3d, float)
@@ -118,8 +128,7 @@ def subdivided(cp: CreasePattern, m: int, grading: float = 1.0) -> tuple[CreaseP
             inner = [(i, j) for i in range(1, m) for j in range(1, m - i)]
             for i, j in inner:
                 idx[(i, j)] = base
-                bary = corner_graded(np.array([m - i - j, i, j]) / m, grading)
-                pts.append(((bary / bary.sum()) @ P)[None])
+                pts.append((P[0] + i / m * (P[1] - P[0]) + j / m * (P[2] - P[0]))[None])
                 pedge.append(np.array([-1], np.int64))
                 base += 1
             for i in range(m):

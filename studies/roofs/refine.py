@@ -27,8 +27,9 @@ one-facet check (docs/roofs.csv, which ``run.py`` writes). The ranking written w
 uses the refined stiffness and buckling factor and the finest nonlinear check.
 
 Run: ``python studies/roofs/refine.py [--quick] [--publish] [--cache=FILE]
-[--only=FAMILY,...] [--no-second-look] [--grading=P]`` (``--grading``: sub-panels crowded
-towards the panels' corners, ``p >= 1``, as the shell reference's facet meshes; ``--only``
+[--only=FAMILY,...] [--no-second-look] [--grading=P]`` (``--grading``: the sub-panels of
+quadrilateral panels crowded towards their corners, ``p >= 1``, as the shell reference's facet
+meshes; ``--only``
 computes those families' roofs into the cache and publishes nothing: two such runs with their
 own caches use two cores;
 ``--no-second-look`` runs no check again from the finer increment). Every level
@@ -73,9 +74,17 @@ RULE = "coupled"
 #: its membrane (``bar_calibration``): cached levels of another membrane are recomputed
 MEMBRANE = roofs.BENDING_RULES[RULE].get("bar_calibration", "fit")
 #: sub-panels crowded towards the panels' corners (``--grading=P``; 1: equal sub-panels;
-#: :func:`barhinge.pattern.subdivide.subdivided`): cached levels of another grading are
-#: recomputed
+#: :func:`barhinge.pattern.subdivide.subdivided`), on roofs of quadrilateral panels (the
+#: others are cut equally); cached levels of another grading are recomputed
 GRADING = float(next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--grading=")), 1))
+
+
+def grading_of(cp) -> float:
+    """The grading of a roof's sub-panels: ``GRADING`` where every panel is a quadrilateral,
+    else 1 (graded triangles break the coupled plate rule's patch test)."""
+    return GRADING if all(len(f) == 4 for f in cp.faces) else 1.0
+
+
 #: no level above this many DOFs is run
 DOF_BUDGET = 16_000 if QUICK else roofs.REFINE_DOF_BUDGET
 #: sub-panels per panel side, tried in order
@@ -123,7 +132,7 @@ def level(cp, sv: np.ndarray, se: np.ndarray, m: int) -> dict[str, Any]:
     from barhinge.scene import self_weight
 
     t0 = time.perf_counter()
-    model, S, residual = roofs.subdivided_roof(cp, sv, se, m, RULE, grading=GRADING)
+    model, S, residual = roofs.subdivided_roof(cp, sv, se, m, RULE, grading=grading_of(cp))
     Fq = roofs.plan_load(model, roofs.Q)
     U, R = linear_response(model, Fq, S)
     Qt = float(-Fq[:, 2].sum())
@@ -137,7 +146,7 @@ def level(cp, sv: np.ndarray, se: np.ndarray, m: int) -> dict[str, Any]:
     return {
         "m": m,
         "membrane": MEMBRANE,
-        "grading": GRADING,
+        "grading": grading_of(cp),
         "n_dof": 3 * model.n_nodes,
         "stiffness": Qt**2 / float(np.sum(Fq * U)),
         "plan_area": Qt / roofs.Q,
@@ -252,11 +261,13 @@ def refine(fam: str, state: float, done: list[dict], save=lambda rows: None) -> 
     """The levels of one roof: ``done`` (cached) extended until the stiffness changes by less
     than ``TOL`` or the next level would exceed ``DOF_BUDGET``; ``save`` is called after every
     new level. Cached levels of another membrane than ``MEMBRANE`` or another grading than
-    ``GRADING`` are not used."""
+    :func:`grading_of` the roof are not used."""
     cp, flat_xy, _ = roofs.folded(fam, state)
     sv, se = roofs.support_lines(cp, flat_xy, roofs.FAMILIES[fam]["axis"])
     rows = [
-        r for r in done if r.get("membrane", "fit") == MEMBRANE and r.get("grading", 1.0) == GRADING
+        r
+        for r in done
+        if r.get("membrane", "fit") == MEMBRANE and r.get("grading", 1.0) == grading_of(cp)
     ]
     rows = rows if len(rows) == len(done) else []
     for m in LEVELS[len(rows) :]:
@@ -1058,7 +1069,8 @@ def section(results: list[dict]) -> str:
             f" Every roof of the comparison table with each panel cut into m × m sub-panels"
             f" (`{RULE}` plate rule, `{MEMBRANE}` membrane"
             + (
-                f", sub-panels graded towards the panels' corners with p = {GRADING:g}"
+                f", sub-panels of quadrilateral panels graded towards their corners with"
+                f" p = {GRADING:g}"
                 if GRADING != 1.0
                 else ""
             )
