@@ -28,7 +28,7 @@ uses the refined stiffness and buckling factor and the finest nonlinear check.
 
 Run: ``python studies/roofs/refine.py [--quick] [--publish] [--cache=FILE]
 [--only=FAMILY,...] [--no-second-look] [--grading=P]`` (``--grading``: the sub-panels of
-quadrilateral panels crowded towards their corners, ``p >= 1``, as the shell reference's facet
+parallelogram panels crowded towards their corners, ``p >= 1``, as the shell reference's facet
 meshes; ``--only``
 computes those families' roofs into the cache and publishes nothing: two such runs with their
 own caches use two cores;
@@ -74,15 +74,25 @@ RULE = "coupled"
 #: its membrane (``bar_calibration``): cached levels of another membrane are recomputed
 MEMBRANE = roofs.BENDING_RULES[RULE].get("bar_calibration", "fit")
 #: sub-panels crowded towards the panels' corners (``--grading=P``; 1: equal sub-panels;
-#: :func:`barhinge.pattern.subdivide.subdivided`), on roofs of quadrilateral panels (the
-#: others are cut equally); cached levels of another grading are recomputed
+#: :func:`barhinge.pattern.subdivide.subdivided`), on roofs of parallelogram panels (the
+#: others are cut equally, :func:`grading_of`); cached levels of another grading are
+#: recomputed
 GRADING = float(next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--grading=")), 1))
 
 
 def grading_of(cp) -> float:
-    """The grading of a roof's sub-panels: ``GRADING`` where every panel is a quadrilateral,
-    else 1 (graded triangles break the coupled plate rule's patch test)."""
-    return GRADING if all(len(f) == 4 for f in cp.faces) else 1.0
+    """The grading of a roof's sub-panels: ``GRADING`` where every panel is a parallelogram,
+    else 1. Graded triangles break the coupled plate rule's patch test; graded trapezoids
+    (the arched Miura's panels) passed it but converged more slowly than equal ones
+    (miura_arc 60 at m = 32: 21.9 kN/m/m graded with p = 2, 27.1 equal, shell 27.6)."""
+    X = np.asarray(cp.vertices3d, float)
+    for f in cp.faces:
+        if len(f) != 4:
+            return 1.0
+        P = X[list(f)]
+        if np.linalg.norm(P[0] - P[1] + P[2] - P[3]) > 1e-9 * np.linalg.norm(P[2] - P[0]):
+            return 1.0
+    return GRADING
 
 
 #: no level above this many DOFs is run
@@ -1069,7 +1079,7 @@ def section(results: list[dict]) -> str:
             f" Every roof of the comparison table with each panel cut into m × m sub-panels"
             f" (`{RULE}` plate rule, `{MEMBRANE}` membrane"
             + (
-                f", sub-panels of quadrilateral panels graded towards their corners with"
+                f", sub-panels of parallelogram panels graded towards their corners with"
                 f" p = {GRADING:g}"
                 if GRADING != 1.0
                 else ""
