@@ -60,7 +60,7 @@ def arc_increment(
         ctx.timer.n_iterations += 1
         if not np.isfinite(rf):
             raise IncrementFailed("non-finite residual", res)
-        if it > 1 and conv.converged(e, new, dx, res, _arc_correction(ctx, e, uh, tan1)):
+        if it > 1 and conv.converged(e, new, dx, _arc_correction(ctx, e, uh, tan1)):
             return new, e, res, tan1, sgn
         if it >= o.max_iter:
             raise IncrementFailed(f"no convergence in {o.max_iter} iterations", res)
@@ -90,8 +90,8 @@ def _arc_correction(
     ctx: SolveContext, e: Evaluation, uh: np.ndarray, tan1: np.ndarray
 ) -> Callable[[], np.ndarray]:
     """The next arc-length correction from the residual of ``e`` with the factorisation at
-    hand (``uh = K^-1 P`` of it), for :meth:`Convergence.converged` to confirm a state
-    accepted by the residual's rate."""
+    hand (``uh = K^-1 P`` of it), for :meth:`Convergence.converged` to judge a state that
+    passes the force test."""
 
     def correction() -> np.ndarray:
         ub, _ = ctx.system.solve(-e.r[ctx.free], -e.c)
@@ -143,7 +143,7 @@ def land_displacement(
         if not np.isfinite(rf):
             why = "non-finite residual"
             break
-        if it > 1 and conv.converged(e, new, dx, res, _landing_correction(ctx, e, uh, k)):
+        if it > 1 and conv.converged(e, new, dx, _landing_correction(ctx, e, uh, k)):
             return new, e, res
         try:
             ctx.factorize(e, new)

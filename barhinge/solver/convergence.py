@@ -49,11 +49,10 @@ class Convergence:
         e: Evaluation,
         st: State,
         dx: np.ndarray,
-        res: list[float],
-        next_correction: Callable[[], np.ndarray] | None = None,
+        next_correction: Callable[[], np.ndarray],
     ) -> bool:
         """Whether the iterate ``st`` passes the force, displacement (``dx``: the last
-        correction) and actuator-angle tests (``res``: force residual norms so far).
+        correction) and actuator-angle tests.
 
         Where the force and actuator tests pass and ``dx`` is above the tolerance, the
         state is judged by ``next_correction`` (a back-substitution of the current residual
@@ -61,9 +60,7 @@ class Convergence:
         estimates this state's error, where ``dx`` measures the previous iterate's: along a
         soft mode a residual at the force floor can still hide a correction far above the
         tolerance (an imperfect strut near its buckling load), and a residual that reached
-        the floor after a large correction needs no further factorisation. Without
-        ``next_correction`` the test passes by the rate of the residual instead (``|dx| q /
-        (1 - q)`` with ``q`` the last contraction, or ``q < 1e-3``)."""
+        the floor after a large correction needs no further factorisation."""
         ctx = self.ctx
         o = ctx.opts
         rf = float(np.linalg.norm(e.r[ctx.free]))
@@ -74,15 +71,7 @@ class Convergence:
         ok_x = float(np.linalg.norm(dx)) <= tol_x
         if ok_x or not (ok_f and ok_c):
             return bool(ok_f and ok_x and ok_c)
-        if next_correction is not None:
-            return float(np.linalg.norm(next_correction())) <= tol_x
-        if len(res) < 2 or not res[-2] > 0:
-            return False
-        q = rf / res[-2]
-        # contracting iteration (ratio q): the remaining error is at most about
-        # |dx| q / (1 - q) (linear rate; less in the quadratic regime)
-        by_rate = q < 1e-3 or (q <= 0.5 and float(np.linalg.norm(dx)) * q / (1 - q) <= tol_x)
-        return bool(by_rate)
+        return float(np.linalg.norm(next_correction())) <= tol_x
 
     def merit(self, e: Evaluation) -> float:
         """``|r_free|^2 + (s c)^2``, force^2."""

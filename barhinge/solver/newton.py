@@ -136,7 +136,7 @@ class _Driver:
             def next_correction(e: Evaluation = e) -> np.ndarray:
                 return self.system.solve(-e.r[free], -e.c)[0]
 
-            if dx_last is not None and self.conv.converged(e, new, dx_last, res, next_correction):
+            if dx_last is not None and self.conv.converged(e, new, dx_last, next_correction):
                 self.n_iter_last = n_iter
                 self._hard_last = n_iter > AUTO_ACCELERATION_AFTER
                 self.inertia.check_inertia(res)

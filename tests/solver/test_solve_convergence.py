@@ -38,13 +38,13 @@ def test_a_state_that_passes_the_force_test_is_judged_by_its_next_correction():
     tol_x = ctx.opts.tol_disp * ctx.size
     big = np.full(ctx.free.sum(), 1e3 * tol_x)  # a last correction far above the tolerance
     small = np.zeros(ctx.free.sum())
-    assert conv.converged(e, st, big, [1.0, 0.9], lambda: small)
-    assert not conv.converged(e, st, big, [1.0, 0.9], lambda: big)
+    assert conv.converged(e, st, big, lambda: small)
+    assert not conv.converged(e, st, big, lambda: big)
     # the force test fails: no correction accepts the state
     off = State(st.x.copy(), st.mu, st.lam, st.t)
     off.x[ctx.free] += 1e-3
     e_off = ctx.evaluate(off)
-    assert not conv.converged(e_off, off, small, [1.0, 0.9], lambda: small)
+    assert not conv.converged(e_off, off, small, lambda: small)
 
 
 def test_states_accepted_by_the_next_correction_lie_within_the_tolerance():
