@@ -73,6 +73,9 @@ class SolverOptions:
         Maximum halvings of a Newton correction in the backtracking line search on
         ``|r|^2 + (s c)^2`` (0 = plain Newton, the default: on stiff-bar / soft-fold
         mechanisms full Newton steps with cut-back of the increment were measured faster).
+        Arc length halves its correctors the same way, load factor included (a scaled
+        corrector keeps the arc-length constraint); thin plates under load, whose full
+        corrections overshoot by orders of magnitude, need it.
     acceleration : bool or "auto"
         Geodesic acceleration of Newton corrections (Transtrum & Sethna 2012,
         arXiv:1201.5885): the second directional derivative of the residual along the step

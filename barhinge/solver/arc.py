@@ -14,6 +14,7 @@ from barhinge.linalg.backends import SingularMatrixError
 from barhinge.solver.bordered import gdcm_scale, gdcm_sign
 from barhinge.solver.context import SolveContext
 from barhinge.solver.convergence import Convergence
+from barhinge.solver.stability import left_branch
 from barhinge.solver.state import Evaluation, IncrementFailed, State
 from barhinge.solver_options import displacement_stop_dof
 
@@ -30,12 +31,16 @@ def arc_increment(
     prev_tan: np.ndarray | None,
     sign: float,
     factored: bool = False,
+    stay_on_branch: bool = False,
 ) -> tuple[State, Evaluation, list[float], np.ndarray, float]:
     """One MGDCM increment from ``st`` (``e`` its evaluation; ``factored``: the system
     holds the factorisation of its tangent): predictor with the GSP-scaled load
     increment, correctors with ``dlambda = -(du_1 . du_bar)/(du_1 . du_hat)`` (Leon et
-    al. 2011). Returns the state, its evaluation, the residual norms, the predictor's
-    tangent and the sign of the load increment."""
+    al. 2011). With ``stay_on_branch`` a converged state farther from the predictor than
+    the predictor is from ``st`` is refused (IncrementFailed): the correctors left the
+    branch and may have jumped over a limit point or a bifurcation unseen. Returns the
+    state, its evaluation, the residual norms, the predictor's tangent and the sign of the
+    load increment."""
     o = ctx.opts
     free = ctx.free
     res: list[float] = []
@@ -50,28 +55,33 @@ def arc_increment(
     new = State(st.x.copy(), st.mu + dlam * mu_hat + mu_bar, st.lam + dlam, st.t)
     dx = dlam * u_hat + u_bar
     new.x[free] += dx
+    x_pred = new.x.copy()
     tan1 = u_hat
     uh = u_hat  # K^-1 P of the factorisation at hand
     it = 1
+    e = ctx.evaluate(new)
     while True:
-        e = ctx.evaluate(new)
         rf = float(np.linalg.norm(e.r[free]))
         res.append(rf)
         ctx.timer.n_iterations += 1
         if not np.isfinite(rf):
             raise IncrementFailed("non-finite residual", res)
         if it > 1 and conv.converged(e, new, dx, _arc_correction(ctx, e, uh, tan1)):
+            jump = left_branch(ctx, st, x_pred, new) if stay_on_branch else ""
+            if jump:
+                raise IncrementFailed(f"the correctors left the branch ({jump})", res)
             return new, e, res, tan1, sgn
         if it >= o.max_iter:
             raise IncrementFailed(f"no convergence in {o.max_iter} iterations", res)
+        if len(res) > 2 and rf > o.divergence_ratio * max(res[0], ctx.floor):
+            raise IncrementFailed("residual diverged", res)
         ctx.factorize_or_fail(e, new, res)
         uh, mh = ctx.system.solve(e.P[free], zc)
         ub, mb = ctx.system.solve(-e.r[free], -e.c)
         dl = _arc_dlam(ub, uh, tan1)
-        dx = dl * uh + ub
-        new.x[free] += dx
-        new.mu = new.mu + dl * mh + mb
-        new.lam += dl
+        # a corrector scaled by the line search stays orthogonal to tan1 (its constraint)
+        new, e, alpha = conv.line_search(new, e, dl * uh + ub, dl * mh + mb, dlam=dl)
+        dx = alpha * (dl * uh + ub)
         it += 1
 
 

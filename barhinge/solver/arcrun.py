@@ -61,7 +61,9 @@ def run_arc_length(d: ArcDriver, progress: Progress | None) -> FoldPath:
     onto exactly that value (from the state before it, else back from the state past
     it); a limit-point stop ends at the first state past the last limit point counted, an
     instability stop at the first state whose tangent has more negative eigenvalues than
-    the starting state's.
+    the starting state's. With either of those stops an increment whose correctors moved
+    farther than its predictor is refused and cut back (it may have jumped the point
+    sought).
     Raises ConvergenceError when an increment fails after its cut-backs, when the step
     cap comes first, or when a landing fails: a path that did not reach its stop is
     never returned as converged."""
@@ -84,6 +86,8 @@ def run_arc_length(d: ArcDriver, progress: Progress | None) -> FoldPath:
     cap = o.arc_max_load_increment
     shorter = 1.0  # arc length kept shorter after an increment climbed past ``cap``
     stop: dict[str, Any] | None = None
+    # a path that stops at its first limit point or loss of stability must not jump one
+    watch = o.arc_stop_instability or o.arc_stop_limit_points is not None
     while stop is None and n < max_steps:
         n += 1
         # the tangent at the converged state: its inertia for the record, and the
@@ -103,7 +107,7 @@ def run_arc_length(d: ArcDriver, progress: Progress | None) -> FoldPath:
         for _cut in range(o.max_cutbacks + 1):
             try:
                 new, e_new, res, tan, sgn = arc_increment(
-                    ctx, d.conv, st, e, scale, first_tan, prev_tan, sign, factored
+                    ctx, d.conv, st, e, scale, first_tan, prev_tan, sign, factored, watch
                 )
             except IncrementFailed as f:
                 factored = False

@@ -88,16 +88,24 @@ class Convergence:
         return bool(q < 0.1 and res[-1] * q * q <= 0.5 * self.tol_abs)
 
     def line_search(
-        self, st: State, e: Evaluation, dx: np.ndarray, dmu: np.ndarray, light: bool = False
+        self,
+        st: State,
+        e: Evaluation,
+        dx: np.ndarray,
+        dmu: np.ndarray,
+        light: bool = False,
+        dlam: float = 0.0,
     ) -> tuple[State, Evaluation, float]:
-        """Backtracking (Armijo) on the merit function; the trial evaluation is reused
-        (``light``: the full step is evaluated without the tangent). Returns the trial
-        state, its evaluation and the step fraction taken."""
+        """Backtracking (Armijo) on the merit function along the correction ``(dx, dmu,
+        dlam)`` (``dlam``: the load-factor part of an arc-length corrector, scaled with the
+        rest so the correction keeps its arc-length constraint); the trial evaluation is
+        reused (``light``: the full step is evaluated without the tangent). Returns the
+        trial state, its evaluation and the step fraction taken."""
         ctx = self.ctx
         phi0 = self.merit(e)
         alpha = 1.0
         for k in range(ctx.opts.line_search + 1):
-            trial = State(st.x.copy(), st.mu + alpha * dmu, st.lam, st.t)
+            trial = State(st.x.copy(), st.mu + alpha * dmu, st.lam + alpha * dlam, st.t)
             trial.x[ctx.free] += alpha * dx
             et = ctx.evaluate(trial, tangent=not (light and k == 0))
             phi = self.merit(et)

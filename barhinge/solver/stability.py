@@ -14,9 +14,20 @@ from barhinge.linalg.backends import SingularMatrixError
 from barhinge.solver.context import SolveContext
 from barhinge.solver.state import Evaluation, IncrementFailed, State, StepRecord
 
-__all__ = ["InertiaMonitor", "stability_events"]
+__all__ = ["InertiaMonitor", "left_branch", "stability_events"]
 
 log = logging.getLogger("barhinge.solver.newton")
+
+
+def left_branch(ctx: SolveContext, st: State, x_pred: np.ndarray, new: State) -> str:
+    """Why the converged state ``new`` left the branch of its increment from ``st``: it lies
+    farther from the predictor ``x_pred`` than the predictor from ``st`` (length), so Newton
+    may have jumped a critical point to a distant equilibrium; "" when it did not."""
+    step = float(np.linalg.norm(x_pred - st.x))
+    corr = float(np.linalg.norm(new.x - x_pred))
+    if corr > step + ctx.opts.tol_disp * ctx.size:
+        return f"correction {corr:.3g} > predictor step {step:.3g}"
+    return ""
 
 
 class InertiaMonitor:
@@ -62,12 +73,11 @@ class InertiaMonitor:
         ctx = self.ctx
         if not ctx.system.track_inertia:
             return
-        step = float(np.linalg.norm(x_pred - st.x))
-        corr = float(np.linalg.norm(new.x - x_pred))
-        if corr > step + ctx.opts.tol_disp * ctx.size:
+        jump = left_branch(ctx, st, x_pred, new)
+        if jump:
             raise IncrementFailed(
-                f"{self.critical}: Newton left the branch (correction {corr:.3g} > predictor step "
-                f"{step:.3g}; use control = 'arc_length' to pass it)",
+                f"{self.critical}: Newton left the branch ({jump}; use control = "
+                "'arc_length' to pass it)",
                 res,
             )
 

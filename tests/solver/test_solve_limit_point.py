@@ -64,6 +64,9 @@ class TrussModel:
         )
         return _Ev(e, f, K)
 
+    def tangent(self, X: np.ndarray) -> sp.csr_matrix:
+        return self.evaluate(X).K
+
     def hinge_angles(self, X: np.ndarray) -> np.ndarray:
         return np.zeros(0)
 
@@ -122,3 +125,63 @@ def test_arc_length_passes_limit_point():
     # ... and ends on the far, inverted branch at exactly the full load
     assert lam[-1] == pytest.approx(1.0, abs=1e-12)
     assert path.X[-1, 2, 2] < -H
+
+
+def test_arc_length_line_search_damps_overshooting_correctors():
+    """A long arc-length increment (4x the default) jumps over the limit point: plain MGDCM
+    correctors overshoot and wander (28 iterations), the backtracking line search
+    (``line_search``, which scales the load-factor part with the rest) takes a third of them,
+    and both paths lie on the closed-form curve."""
+    iterations = {}
+    for ls in (0, 8):
+        base = _truss_scene(1.5 * F_LIMIT, "arc_length", 10)
+        scene = Scene(
+            base.model, supports=base.supports, loads=base.loads, steps=10,
+            control="arc_length",
+            options={"line_search": ls, "arc_length_increment": 4.0, "max_cutbacks": 0},
+        )  # fmt: skip
+        path = bh.solve(scene)
+        w = H - path.X[:, 2, 2]
+        np.testing.assert_allclose(
+            path.load_factor * 1.5 * F_LIMIT, _curve(w), rtol=0, atol=1e-6 * F_LIMIT
+        )
+        assert path.load_factor[-1] == pytest.approx(1.0, abs=1e-12)
+        iterations[ls] = path.meta["newton"]["total_iterations"]
+    assert iterations[8] * 2 < iterations[0]
+
+
+def test_critical_ahead_of_the_last_stable_states_finds_the_limit_load():
+    """The stable states before the truss's limit point, as a path whose increments failed
+    there leaves them: the lowest tangent eigenvalue falls like ``sqrt(F_max - F)``, so the
+    extrapolation of its square lands on the closed-form limit load and that of the
+    eigenvalue itself beyond it (``critical_ahead`` brackets it)."""
+    from barhinge.analysis.buckling import critical_ahead
+
+    scene = _truss_scene(1.5 * F_LIMIT, "arc_length", 40)
+    scene = Scene(scene.model, supports=scene.supports, loads=scene.loads, steps=40,
+                  control="arc_length", options={"arc_stop_instability": True})  # fmt: skip
+    path = bh.solve(scene)
+    stable = np.asarray(path.meta["negative_eigenvalues"]) == 0
+    X, lam = np.asarray(path.X)[stable], np.asarray(path.load_factor)[stable]
+    ahead = critical_ahead(scene.model, scene.supports, X, lam)
+    lam_max = F_LIMIT / (1.5 * F_LIMIT)
+    assert ahead.estimate == pytest.approx(lam_max, rel=2e-3)
+    assert lam[-1] < ahead.estimate and ahead.linear > lam_max
+
+
+def test_a_state_that_left_its_branch_is_named():
+    """A converged state farther from its predictor than the predictor from the start left
+    the branch (arc length with a limit-point or instability stop refuses that increment,
+    load control too); one within that distance did not."""
+    from types import SimpleNamespace
+
+    from barhinge.solver.stability import left_branch
+    from barhinge.solver.state import State
+
+    ctx = SimpleNamespace(opts=SimpleNamespace(tol_disp=1e-8), size=1.0)
+    start = State(np.zeros(3), np.zeros(0), 0.0, 0.0)
+    pred = np.array([1.0, 0.0, 0.0])
+    near = State(np.array([1.0, 0.9, 0.0]), np.zeros(0), 0.5, 0.0)
+    assert left_branch(ctx, start, pred, near) == ""
+    far = State(np.array([1.0, 1.1, 0.0]), np.zeros(0), 0.5, 0.0)
+    assert left_branch(ctx, start, pred, far) == "correction 1.1 > predictor step 1"
