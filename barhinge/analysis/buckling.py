@@ -38,6 +38,8 @@ from barhinge.linalg.threads import threads_for_sparse
 
 __all__ = [
     "Buckling",
+    "CriticalAhead",
+    "critical_ahead",
     "critical_between",
     "linear_buckling",
     "stiffness_parts",
@@ -291,6 +293,94 @@ def critical_between(
         else:
             lo = mid
     return float(lam_a + 0.5 * (lo + hi) * (lam_b - lam_a))
+
+
+@dataclasses.dataclass(frozen=True)
+class CriticalAhead:
+    """A loss of stability just ahead of a path's last state (:func:`critical_ahead`).
+
+    Attributes
+    ----------
+    estimate : float
+        Load factor where the squared lowest eigenvalue, extrapolated linearly in the load
+        factor, reaches zero: exact at a limit point (``mu ~ sqrt(lam_c - lam)``), slightly
+        early at a bifurcation (``mu ~ lam_c - lam``).
+    linear : float
+        Where the lowest eigenvalue itself, extrapolated linearly, reaches zero: exact at a
+        bifurcation, late at a limit point. ``[estimate, linear]`` brackets the critical
+        load factor in both cases.
+    load_factors, lowest : (k,) float
+        The last states' load factors and the lowest eigenvalues of their free tangents
+        (force / length).
+    """
+
+    estimate: float
+    linear: float
+    load_factors: np.ndarray
+    lowest: np.ndarray
+
+
+@threads_for_sparse
+def critical_ahead(
+    model: Any, fixed: np.ndarray, X: np.ndarray, lam: np.ndarray, states: int = 3
+) -> CriticalAhead:
+    """The critical point a path runs into past its last state, from the lowest eigenvalue
+    of the free tangent at its last ``states`` states (shift-invert Lanczos at 0).
+
+    For a path whose increments fail at a critical point: every state recorded is stable,
+    none lies past it, and :func:`critical_between` has no bracket. The lowest eigenvalues
+    must be positive and fall monotonically over those states, and the extrapolated zero must
+    lie within the larger of the last two load-factor increments ahead of the last state.
+
+    Parameters
+    ----------
+    model : the bar-and-hinge model; fixed : (n_nodes, 3) bool, the supports
+    X : (n_states, n_nodes, 3) float, the path's states; lam : (n_states,) their load factors
+
+    Raises
+    ------
+    BucklingError
+        If there are fewer than ``states`` states (at least 2), a tangent is not positive
+        definite, the eigenvalues do not fall, or their zero lies farther ahead.
+    """
+    import scipy.sparse.linalg as sla
+
+    lam = np.asarray(lam, float)
+    k = min(int(states), len(lam))
+    if k < 2:
+        raise BucklingError("critical_ahead: needs at least two states of the path")
+    n = model.n_nodes
+    free = np.flatnonzero(~np.asarray(fixed, bool).ravel())
+    lowest = []
+    for Xs in np.asarray(X, float)[-k:]:
+        K = sp.csc_matrix(model.tangent(Xs.reshape(n, 3))[free][:, free])
+        if len(free) <= DENSE_PENCIL:
+            import scipy.linalg
+
+            mu = scipy.linalg.eigvalsh(K.toarray(), subset_by_index=[0, 0])
+        else:  # the eigenvalue nearest 0: the lowest while the tangent is positive definite
+            mu = sla.eigsh(K, k=1, sigma=0.0, which="LM", return_eigenvectors=False)
+        lowest.append(float(mu[0]))
+    mu = np.asarray(lowest)
+    lam_k = lam[-k:]
+    if not (np.all(mu > 0.0) and np.all(np.diff(mu) < 0.0)):
+        raise BucklingError(
+            "critical_ahead: the lowest tangent eigenvalues of the last states "
+            f"({', '.join(f'{v:.4g}' for v in mu)}) are not positive and falling"
+        )
+    dlam = lam_k[-1] - lam_k[-2]
+    if dlam == 0.0:
+        raise BucklingError("critical_ahead: the last two states have the same load factor")
+    linear = float(lam_k[-1] + mu[-1] * dlam / (mu[-2] - mu[-1]))
+    estimate = float(lam_k[-1] + mu[-1] ** 2 * dlam / (mu[-2] ** 2 - mu[-1] ** 2))
+    reach = float(np.max(np.abs(np.diff(lam[-3:]))))
+    if abs(linear - lam_k[-1]) > reach:
+        raise BucklingError(
+            f"critical_ahead: the lowest tangent eigenvalue ({mu[-1]:.4g} at load factor "
+            f"{lam_k[-1]:.6g}) reaches zero at {linear:.6g}, farther ahead than the last "
+            f"increments ({reach:.3g})"
+        )
+    return CriticalAhead(estimate, linear, lam_k.copy(), mu)
 
 
 def _hinge_dofs(model: Any) -> np.ndarray:

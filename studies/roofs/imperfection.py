@@ -174,7 +174,9 @@ def run(
 ) -> list[dict]:
     """Check every roof at every (amplitude, mode) of ``tasks`` (default: every amplitude of
     ``AMPLITUDES`` on mode 1); cached checks are read back, the cache is written after each
-    check."""
+    check. A check that loses stability or fails is run again from the first increment
+    ``1 / FINE_STEPS``; that one is kept, with the coarse one's critical load factor as
+    ``coarse_critical`` (or its failure as ``coarse_error``)."""
     store: dict[str, dict] = (
         json.loads(cache.read_text()) if cache is not None and cache.exists() else {}
     )
@@ -191,11 +193,16 @@ def run(
                 cache.write_text(json.dumps(store, indent=0))
         coarse = store[key]
         coarse_increment = coarse.get("first_increment", 1.0 / STEPS)
-        if critical(coarse) is not None and coarse_increment > 1.0 / FINE_STEPS:
-            print(f"  {fam} {state:g} loses stability: again with increment 1/{FINE_STEPS}",
+        second_look = coarse["error"] or critical(coarse) is not None
+        if second_look and coarse_increment > 1.0 / FINE_STEPS:
+            why = "fails" if coarse["error"] else "loses stability"
+            print(f"  {fam} {state:g} {why}: again with increment 1/{FINE_STEPS}",
                   file=sys.stderr, flush=True)  # fmt: skip
             fine = check(fam, state, m, name, steps=FINE_STEPS, mode=mode)
-            fine["coarse_critical"] = critical(coarse)
+            if coarse["error"]:
+                fine["coarse_error"] = coarse["error"]
+            else:
+                fine["coarse_critical"] = critical(coarse)
             store[key] = fine
             if cache is not None:
                 cache.write_text(json.dumps(store, indent=0))
@@ -207,19 +214,45 @@ def _num(v: Any, fmt: str = ".3f") -> str:
     return "–" if v is None or (isinstance(v, float) and not np.isfinite(v)) else format(v, fmt)
 
 
+def _coarse_note(row: dict[str, Any]) -> str:
+    """What the first, coarser path of a check that was run again found ("" if none)."""
+    if row.get("coarse_error"):
+        return f" (increment 1/{STEPS}: failed)"
+    coarse = row.get("coarse_critical")
+    if coarse is None:
+        return ""
+    return f" (increment 1/{STEPS}: " + (
+        f"loses stability at {coarse:.3f})" if critical(row) is None else f"{coarse:.3f})"
+    )
+
+
+def _lost(row: dict[str, Any], c: float) -> str:
+    """Where a check loses stability, marked where it is extrapolated past the path's last
+    state (``stop`` ``"critical_ahead"``: the increments failed just before it)."""
+    ahead = row.get("stop") == "critical_ahead"
+    return f"loses stability at {c:.3f}" + (" (extrapolated, ‡)" if ahead else "")
+
+
+def _ahead_note(rows: list[dict]) -> list[str]:
+    """The footnote of the ‡ mark, where a row carries it."""
+    if not any(r.get("stop") == "critical_ahead" and not r["error"] for r in rows):
+        return []
+    return [
+        "",
+        "‡ The path's increments fail just before this critical point: every state"
+        " reached is stable, and the lowest eigenvalue of the tangent falls to zero within"
+        " the last increments ahead of the last one. The load factor given is where its"
+        " square, extrapolated linearly, vanishes (exact at a limit point, slightly early at"
+        " a bifurcation; `barhinge.analysis.buckling.critical_ahead`).",
+    ]
+
+
 def verdict(row: dict[str, Any]) -> str:
     if row["error"]:
         return f"failed: {row['error']}"
     c = critical(row)
-    if c is None:
-        coarse = row.get("coarse_critical")
-        return "carries the design load" + (
-            f" (increment 1/{STEPS}: loses stability at {coarse:.3f})" if coarse else ""
-        )
-    text = f"loses stability at {c:.3f}"
-    if row.get("coarse_critical") is not None:
-        text += f" (increment 1/{STEPS}: {row['coarse_critical']:.3f})"
-    return text
+    text = "carries the design load" if c is None else _lost(row, c)
+    return text + _coarse_note(row)
 
 
 def _by_roof(rows: list[dict]) -> dict[tuple[str, float], dict[str, dict]]:
@@ -312,13 +345,14 @@ def section(rows: list[dict], perfect: dict[tuple[str, float], dict[str, str]]) 
             " first mode). The imperfect roof is stress-free in its imperfect shape and"
             " followed by the same arc length to the design load or the first loss of"
             f" stability (first increment 1/{STEPS} of the load; a roof that loses stability"
-            f" is followed again from 1/{FINE_STEPS}, since a coarse increment can pass the"
-            " first critical point, and that path's result is given, the coarse one"
-            " beside it); deflections are measured from the imperfect shape.",
+            f" or whose path fails is followed again from 1/{FINE_STEPS}, since a coarse"
+            " increment can pass the first critical point, and that path's result is given,"
+            " the coarse one beside it); deflections are measured from the imperfect shape.",
             "",
             summary(rows, perfect),
             "",
             table(rows, perfect),
+            *_ahead_note(rows),
             "",
             END,
         ]
@@ -358,9 +392,8 @@ def _effect(r: dict, perfect: dict[tuple[str, float], dict[str, str]]) -> str:
     if r["error"]:
         return "failed: " + r["error"]
     c = critical(r)
-    if c is not None:
-        return f"loses stability at {c:.3f}"
-    return f"× {_growth(r, perfect):.2f}"
+    text = _lost(r, c) if c is not None else f"× {_growth(r, perfect):.2f}"
+    return text + _coarse_note(r)
 
 
 def _severity(r: dict, perfect: dict[tuple[str, float], dict[str, str]]) -> float:
@@ -460,6 +493,7 @@ def sensitivity_section(rows: list[dict], perfect: dict[tuple[str, float], dict[
             "First mode, growing amplitude:",
             "",
             "\n".join(lines2),
+            *_ahead_note(rows),
             "",
             SENS_END,
         ]
@@ -469,9 +503,9 @@ def sensitivity_section(rows: list[dict], perfect: dict[tuple[str, float], dict[
 def write_csv(rows: list[dict], path: Path = CSV_OUT) -> None:
     cols = ["family", "state", "imperfection", "mode", "m", "n_dof", "panel_side", "amplitude",
             "buckling_factor",
-            "stop", "critical_load_factor", "coarse_critical", "first_increment",
+            "stop", "critical_load_factor", "coarse_critical", "coarse_error", "first_increment",
             "load_factor_reached", "deflection_nonlinear",
-            "states", "iterations", "time_s", "error"]  # fmt: skip
+            "states", "iterations", "time_s", "failure", "error"]  # fmt: skip
     with path.open("w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(cols)

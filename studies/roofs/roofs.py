@@ -665,6 +665,12 @@ def nonlinear_check(
         the tangent interpolated between them turns singular
         (:func:`barhinge.analysis.buckling.critical_between`; None, with the reason in
         ``instability_estimate_error``, where it cannot be found).
+        With ``stop_at_instability``, a path whose increments fail where the lowest
+        tangent eigenvalue of its last states falls to zero just ahead ends there:
+        ``stop`` is ``"critical_ahead"``, ``instability_estimate`` the zero of the squared
+        eigenvalue and ``instability_bracket`` that and the zero of the eigenvalue
+        (:func:`barhinge.analysis.buckling.critical_ahead`), ``failure`` the solver's
+        message; any other failure is raised.
         ``deflection_nonlinear``: the largest deflection at the end of the path (at load
         factor 1 when it is reached), m. ``stop``: the criterion that ended the path.
         ``load_factor_reached``: the path's largest load factor. ``events``: the solver's
@@ -672,14 +678,28 @@ def nonlinear_check(
         iterations. ``path``: the FoldPath itself, with ``keep_path``.
     """
     import barhinge as bh
+    from barhinge.analysis.buckling import critical_ahead
+    from barhinge.errors import BucklingError, ConvergenceError
     from barhinge.scene import Scene
 
     scene = Scene(model, supports=fixed, loads=P, control="arc_length", steps=steps,
                   options={"arc_stop_load_factor": 1.0, "arc_stop_limit_points": 1,
                            "arc_stop_instability": stop_at_instability,
                            "max_arc_steps": 40 * steps})  # fmt: skip
-    path = bh.solve(scene)
-    stop = path.meta["arc_stop"]["criterion"]
+    ahead = None
+    try:
+        path = bh.solve(scene)
+        stop = path.meta["arc_stop"]["criterion"]
+    except ConvergenceError as exc:
+        # increments that fail at a critical point: every state is stable, none past it
+        path = exc.last_state
+        if not (stop_at_instability and isinstance(path, bh.FoldPath)):
+            raise
+        try:
+            ahead = critical_ahead(model, fixed, path.X, path.load_factor)
+        except BucklingError:
+            raise exc from None
+        stop = "critical_ahead"
     lam = np.asarray(path.load_factor)
     U = np.asarray(path.X[-1]) - np.asarray(path.X[0])
     neg = list(path.meta["negative_eigenvalues"])
@@ -687,9 +707,11 @@ def nonlinear_check(
     limit = float(lam.max()) if stop == "limit_points" else None
     unstable = [v for v in (limit, None if first_neg is None else float(lam[first_neg])) if v]
     bracket, estimate, why = None, None, ""
+    if ahead is not None:
+        unstable.append(ahead.estimate)
+        bracket, estimate = [ahead.estimate, ahead.linear], ahead.estimate
     if first_neg is not None and first_neg > 0:
         from barhinge.analysis.buckling import critical_between
-        from barhinge.errors import BucklingError
 
         k = first_neg
         bracket = [float(lam[k - 1]), float(lam[k])]
@@ -706,6 +728,7 @@ def nonlinear_check(
         "deflection_nonlinear": float(np.max(-U[:, 2])),
         "load_factor_reached": float(lam.max()),
         "stop": stop,
+        "failure": "" if ahead is None else str(path.message).splitlines()[0],
         "events": list(path.meta.get("events", [])),
         "states": len(lam),
         "iterations": int(path.meta["newton"]["total_iterations"]),

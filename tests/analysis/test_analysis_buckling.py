@@ -7,7 +7,12 @@ import numpy as np
 import pytest
 
 import barhinge as bh
-from barhinge.analysis.buckling import critical_between, linear_buckling, stiffness_parts
+from barhinge.analysis.buckling import (
+    critical_ahead,
+    critical_between,
+    linear_buckling,
+    stiffness_parts,
+)
 from barhinge.errors import BucklingError
 from barhinge.pattern.crease import CreasePattern
 
@@ -101,6 +106,37 @@ def test_arc_length_stops_where_the_strut_bifurcates(monkeypatch):
     monkeypatch.setattr(buckling, "DENSE_PENCIL", 0)
     bisected = critical_between(m, S, X[-2], X[-1], lam[-2], lam[-1], rtol=1e-6)
     assert bisected == pytest.approx(p1, rel=1e-5)
+
+
+def test_critical_ahead_of_the_last_stable_states_of_the_strut(monkeypatch):
+    """The strut's straight path (above) without its first unstable state, as a path whose
+    increments failed at the critical point leaves it: the lowest tangent eigenvalue of the
+    last stable states falls linearly in the load (the tangent is linear in it), so its
+    linear extrapolation lands on ``P_1 = (4 k / l) sin^2(pi / (2 n))`` and the extrapolation
+    of its square (exact at a limit point) just below."""
+    from barhinge.scene import Scene
+
+    n, ell, k = 5, 1.0, 2.0
+    m, S, P = _strip(n, ell=ell, k=k)
+    p1 = 4 * k / ell * np.sin(np.pi / (2 * n)) ** 2
+    opts = {"arc_stop_instability": True, "arc_stop_load_factor": 3.0, "max_arc_steps": 200}
+    path = bh.solve(Scene(m, supports=S, loads=P, control="arc_length", steps=20, options=opts))
+    X, lam = np.asarray(path.X)[:-1], np.asarray(path.load_factor)[:-1]
+    ahead = critical_ahead(m, S, X, lam)
+    assert ahead.linear == pytest.approx(p1, rel=1e-5)
+    assert lam[-1] < ahead.estimate < p1
+    assert np.all(np.diff(ahead.lowest) < 0) and ahead.lowest[-1] > 0
+    # far from the critical load the zero is out of reach: a named error
+    with pytest.raises(BucklingError, match="farther ahead than the last increments"):
+        critical_ahead(m, S, X[:4], lam[:4])
+    # the same eigenvalues by shift-invert Lanczos (large systems)
+    from barhinge.analysis import buckling
+
+    monkeypatch.setattr(buckling, "DENSE_PENCIL", 0)
+    sparse = critical_ahead(m, S, X, lam)
+    # to round-off of the tangent, whose largest entries (the rigid panels) are ~1e7
+    np.testing.assert_allclose(sparse.lowest, ahead.lowest, rtol=0, atol=1e-7)
+    assert sparse.linear == pytest.approx(p1, rel=1e-5)
 
 
 def test_critical_between_two_stable_states_is_a_named_error():

@@ -87,6 +87,12 @@ def test_verdict_names_the_coarse_increment_where_the_finer_path_differs(study) 
     lost = {**base, "instability_estimate": 0.918, "coarse_critical": 0.667}
     assert study.verdict(lost) == f"loses stability at 0.918 (increment 1/{study.STEPS}: 0.667)"
     assert study.verdict({**base, "error": "no convergence"}) == "failed: no convergence"
+    ahead = {**lost, "coarse_critical": None, "stop": "critical_ahead"}
+    assert study.verdict(ahead) == "loses stability at 0.918 (extrapolated, ‡)"
+    assert "‡ The path's increments fail just before" in "\n".join(study._ahead_note([ahead]))
+    assert study._ahead_note([lost]) == []
+    rescued = {**lost, "coarse_critical": None, "coarse_error": "no convergence"}
+    assert study.verdict(rescued) == f"loses stability at 0.918 (increment 1/{study.STEPS}: failed)"
 
 
 def test_sensitivity_tasks_and_amplitudes(study) -> None:
@@ -130,3 +136,24 @@ def test_sensitivity_picks_the_lowest_factor_and_names_the_worst_mode(study) -> 
     assert "span/300: mode 2, loses stability at 0.800 against × 1.10" in text
     assert "1 of the 10 checks lose stability" in text
     assert text.count("| pleats | 30 |") == 4 + 1  # four modes, one amplitude row
+
+
+def test_a_failed_check_is_run_again_with_the_finer_increment(study, monkeypatch) -> None:
+    """A coarse path that fails gets the second look a lost stability gets: the check again
+    from the first increment 1 / FINE_STEPS, kept with the coarse failure beside it."""
+    calls = []
+
+    def fake_check(fam, state, m, name, steps=study.STEPS, mode=1):
+        calls.append(steps)
+        row = {"family": fam, "state": state, "imperfection": name, "mode": mode,
+               "error": "", "limit_load_factor": None, "instability_estimate": None,
+               "instability_load_factor": None, "first_increment": 1.0 / steps}  # fmt: skip
+        if steps == study.STEPS:
+            return {**row, "error": "arc-length increment 10 did not converge"}
+        return {**row, "limit_load_factor": 0.775}
+
+    monkeypatch.setattr(study, "check", fake_check)
+    [row] = study.run([("miura60", 15.0)], 8, None, [("b/200", 2)])
+    assert calls == [study.STEPS, study.FINE_STEPS]
+    assert row["error"] == "" and row["coarse_error"].startswith("arc-length increment 10")
+    assert study.verdict(row) == f"loses stability at 0.775 (increment 1/{study.STEPS}: failed)"
