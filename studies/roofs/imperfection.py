@@ -455,6 +455,7 @@ def sensitivity_section(rows: list[dict], perfect: dict[tuple[str, float], dict[
     summary_text = (
         "The most harmful mode at each code amplitude (the earliest loss of stability, else"
         " the largest deflection), where it is not the first (by more than"
+        f" {SENSITIVITY_MARGIN:g} in the load factor of the loss of stability, or"
         f" {100 * SENSITIVITY_MARGIN:g} % of the perfect roof's deflection):\n\n"
         + "\n".join(bullets)
         + "\n\n"
