@@ -343,6 +343,7 @@ def critical_ahead(
         If there are fewer than ``states`` states (at least 2), a tangent is not positive
         definite, the eigenvalues do not fall, or their zero lies farther ahead.
     """
+    import scipy.linalg
     import scipy.sparse.linalg as sla
 
     lam = np.asarray(lam, float)
@@ -355,8 +356,6 @@ def critical_ahead(
     for Xs in np.asarray(X, float)[-k:]:
         K = sp.csc_matrix(model.tangent(Xs.reshape(n, 3))[free][:, free])
         if len(free) <= DENSE_PENCIL:
-            import scipy.linalg
-
             mu = scipy.linalg.eigvalsh(K.toarray(), subset_by_index=[0, 0])
         else:  # the eigenvalue nearest 0: the lowest while the tangent is positive definite
             mu = sla.eigsh(K, k=1, sigma=0.0, which="LM", return_eigenvectors=False)

@@ -678,7 +678,7 @@ def nonlinear_check(
         iterations. ``path``: the FoldPath itself, with ``keep_path``.
     """
     import barhinge as bh
-    from barhinge.analysis.buckling import critical_ahead
+    from barhinge.analysis.buckling import critical_ahead, critical_between
     from barhinge.errors import BucklingError, ConvergenceError
     from barhinge.scene import Scene
 
@@ -711,8 +711,6 @@ def nonlinear_check(
         unstable.append(ahead.estimate)
         bracket, estimate = [ahead.estimate, ahead.linear], ahead.estimate
     if first_neg is not None and first_neg > 0:
-        from barhinge.analysis.buckling import critical_between
-
         k = first_neg
         bracket = [float(lam[k - 1]), float(lam[k])]
         try:
