@@ -42,6 +42,7 @@ LAYERS: list[tuple[str, list[str]]] = [
             "barhinge._protocols",
             "barhinge._deprecated",
             "barhinge._publish",
+            "barhinge._study_args",
         ],
     ),
     ("linalg", ["barhinge.linalg", "barhinge.linalg.*"]),

@@ -28,6 +28,10 @@ sys.path.insert(0, str(HERE))
 import scenes  # noqa: E402
 
 MAIN = __name__ == "__main__"
+if MAIN:  # a mistyped option or --help must not start the full run
+    from barhinge._study_args import check_study_argv
+
+    check_study_argv(__doc__, flags=("--quick", "--publish"), valued=())
 QUICK = not MAIN or "--quick" in sys.argv
 #: load-step counts of the converged roof runs whose median is the roof's reference
 ROOF_REFERENCE_STEPS = (1, 8, 32, 64)

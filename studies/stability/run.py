@@ -46,6 +46,10 @@ from barhinge.verify import degree4_pattern, von_mises_limit_load, von_mises_mod
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 MAIN = __name__ == "__main__"
+if MAIN:  # a mistyped option or --help must not start the full run
+    from barhinge._study_args import check_study_argv
+
+    check_study_argv(__doc__, flags=("--quick",), valued=())
 QUICK = not MAIN or "--quick" in sys.argv
 
 MAT = bh.Material(E=1.0e6, nu=0.3, t=0.01)
