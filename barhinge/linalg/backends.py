@@ -278,6 +278,7 @@ class PardisoBackend:
         self._upper_key: tuple | None = None
         self._upper_map: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._generation = 0
+        self._held = False  # a numeric factor is in PARDISO's memory
         self._fallback = SuperLUBackend()
 
     def __del__(self) -> None:
@@ -291,6 +292,24 @@ class PardisoBackend:
                 solver.free_memory(everything=True)
             except Exception:  # interpreter shutdown: MKL may be unloaded already
                 pass
+
+    def factor_bytes(self) -> int:
+        """Memory of the current numeric factor (bytes; PARDISO's ``iparm(17)``, the memory
+        of its numeric factorisation and solution); 0 when none is held."""
+        if not self._held:
+            return 0
+        return 1024 * int(self._solver.iparm[16])
+
+    def release(self) -> None:
+        """Free the numeric factor PARDISO holds (phase 0), keeping the ordering and analysis
+        of the pattern: the next factorisation of the pattern is numeric only. Factors made
+        before can no longer solve. For a backend whose factor is only read once (an inertia
+        count), this returns a factor's worth of memory between factorisations."""
+        if not self._held:
+            return
+        self._solver.free_memory(everything=False)  # phase 0: L and U of the matrix only
+        self._generation += 1
+        self._held = False
 
     def _upper(self, A: sp.spmatrix) -> sp.csr_matrix:
         """Upper triangle of A in CSR (explicit zeros kept), through a map built once per
@@ -331,7 +350,11 @@ class PardisoBackend:
         s = self._solver
         try:
             if key != self._key:
-                s.factorize(U)  # phase 12: analysis + numeric factorisation
+                # phase 12: analysis + numeric factorisation (called directly: pypardiso's
+                # ``factorize`` keeps a copy of the matrix, which the factor holds already)
+                s.set_phase(12)
+                s._call_pardiso(U, np.zeros((U.shape[0], 1)))
+                s.factorized_A = U
                 self._key = key
             else:
                 s.set_phase(22)  # numeric factorisation with the stored analysis
@@ -343,10 +366,14 @@ class PardisoBackend:
                 # analysis of the pattern standing (only a failed first one is redone)
                 if self._key != key:
                     self._key = None
+                # the refused attempt replaced the last factor and holds its memory
+                self._generation += 1
+                self._held = self._key is not None
                 raise IndefiniteMatrixError(f"PARDISO Cholesky: {exc}") from exc
             self._key = None
             raise SingularMatrixError(f"PARDISO: {exc}") from exc
         self._generation += 1
+        self._held = True
         factor = _PardisoFactor(self, U, self._generation)
         if not upper and factor.perturbed_pivots() > 0:
             # nearly singular to working precision: PARDISO's solves would be approximate.
