@@ -37,8 +37,12 @@ def _node_pair_keys(conn: np.ndarray, n_nodes: int) -> np.ndarray:
     """``min * n_nodes + max`` of every node pair ``(a, b)``, ``a <= b`` locally, of every
     element (entry-major: pair by pair, the elements within)."""
     la, lb = np.triu_indices(conn.shape[1])
-    A, B = conn[:, la], conn[:, lb]
-    return (np.minimum(A, B) * n_nodes + np.maximum(A, B)).T.ravel()
+    cT = np.ascontiguousarray(conn.T)  # node slot-major: the pair rows below are contiguous
+    A, B = cT[la], cT[lb]
+    keys = np.minimum(A, B)
+    keys *= n_nodes
+    keys += np.maximum(A, B)
+    return keys.ravel()
 
 
 class Assembler:

@@ -90,15 +90,19 @@ def _coef(p: np.ndarray) -> np.ndarray:
 
 
 def _angle_row(a, b, wings, da: float = 0.0, db: float = 0.0) -> np.ndarray:
-    """(4,) linearised dihedral angle of the hinge a -> b per (k11, k22, k12, delta); wings
-    is a list of (point, centre flag); da, db: centre flags of the axis ends."""
+    """(..., 4) linearised dihedral angle of the hinge a -> b (points (..., 2)) per
+    (k11, k22, k12, delta); wings is a list of (point (..., 2), centre flag); da, db: centre
+    flags of the axis ends. Vectorised over the leading axes (one hinge of many cells)."""
     u = b - a
-    g = np.zeros(4)
+    uu = np.einsum("...i,...i->...", u, u)
+    g = np.zeros(np.shape(a)[:-1] + (4,))
     for p, dp in wings:
-        s = float((p - a) @ u / (u @ u))
-        d = float(np.linalg.norm(p - a - s * u))
-        g[:3] += (_coef(p) - (1 - s) * _coef(a) - s * _coef(b)) / d
-        g[3] += (dp - (1 - s) * da - s * db) / d
+        s = np.einsum("...i,...i->...", p - a, u) / uu
+        d = np.linalg.norm(p - a - s[..., None] * u, axis=-1)
+        g[..., :3] += (_coef(p) - (1 - s)[..., None] * _coef(a) - s[..., None] * _coef(b)) / d[
+            ..., None
+        ]
+        g[..., 3] += (dp - (1 - s) * da - s * db) / d
     return g
 
 
@@ -106,31 +110,37 @@ def _cell_rows(P: np.ndarray, wings: np.ndarray | None = None):
     """Angle rows, energy weights and groups of a cell's hinges, in the order: quad: side i
     (P_i -> P_i+1) for i = 0..3, then half-diagonal P_i -> centre; triangle: side i.
 
-    ``wings`` (4, 2), quads only: the neighbour cell's centre node across each side, in the
-    cell's plane; by default (and where a row is NaN) the point reflection of the cell's own
-    centre through the side's midpoint (exact on a grid of equal parallelograms)."""
+    ``P`` (k, 2) or, for many cells of one size at once, (nc, k, 2); the rows are then
+    (nc, n, 4) (the weights and groups are the same for every cell of a size).
+    ``wings`` (4, 2) or (nc, 4, 2), quads only: the neighbour cell's centre node across each
+    side, in the cell's plane; by default (and where a row is NaN) the point reflection of
+    the cell's own centre through the side's midpoint (exact on a grid of equal
+    parallelograms)."""
+    P = np.asarray(P, float)
     rows, w, grp = [], [], []
-    if len(P) == 4:
+    if P.shape[-2] == 4:
         c = quad_centres(P)  # the model's centre node (triangulate: where the diagonals cross)
         for i in range(4):
-            a, b = P[i], P[(i + 1) % 4]
+            a, b = P[..., i, :], P[..., (i + 1) % 4, :]
             nb = a + b - c
-            if wings is not None and np.isfinite(wings[i]).all():
-                nb = wings[i]
+            if wings is not None:
+                wi = np.asarray(wings, float)[..., i, :]
+                nb = np.where(np.isfinite(wi).all(axis=-1)[..., None], wi, nb)
             rows.append(_angle_row(a, b, [(c, 1.0), (nb, 1.0)]))
             w.append(0.5)
             grp.append(i % 2)
         for i in range(4):
-            rows.append(_angle_row(P[i], c, [(P[(i + 1) % 4], 0.0), (P[i - 1], 0.0)], 0.0, 1.0))
+            wings_i = [(P[..., (i + 1) % 4, :], 0.0), (P[..., i - 1, :], 0.0)]
+            rows.append(_angle_row(P[..., i, :], c, wings_i, 0.0, 1.0))
             w.append(1.0)
             grp.append(2 + i % 2)
     else:
         for i in range(3):
-            a, b, o = P[i], P[(i + 1) % 3], P[(i + 2) % 3]
+            a, b, o = P[..., i, :], P[..., (i + 1) % 3, :], P[..., (i + 2) % 3, :]
             rows.append(_angle_row(a, b, [(o, 0.0), (a + b - o, 0.0)]))
             w.append(0.5)
             grp.append(i)
-    return np.array(rows), np.array(w), np.array(grp)
+    return np.stack(rows, axis=-2), np.array(w), np.array(grp)
 
 
 def _condensed(k: np.ndarray, rows: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -298,7 +308,7 @@ def consistent_bending(model: BarHingeModel) -> BarHingeModel:
 
 def cell_matrix(
     P: np.ndarray, nu: float, wings: np.ndarray | None = None
-) -> tuple[np.ndarray, float]:
+) -> tuple[np.ndarray, float | np.ndarray]:
     """Energy matrix over D of one flat cell's hinge angles, with couplings (the sheet's nu).
 
     The cell stores ``theta^T K theta D / 2`` (``theta`` its hinge angles in the order of
@@ -315,42 +325,51 @@ def cell_matrix(
     largest value that keeps ``C`` positive semi-definite, so ``K`` is positive definite
     wherever ``K_d`` is (no zero-energy mode beyond the rigid ones).
 
+    ``P`` (k, 2) is one cell; (nc, k, 2) are many cells of one size at once (``wings``
+    then (nc, 4, 2)), computed together.
+
     Returns
     -------
-    K : (n, n) float, symmetric positive semi-definite
-    residual : float, largest |entry| of the condensed mismatch / D (round-off when exact)
+    K : (n, n) or (nc, n, n) float, symmetric positive semi-definite
+    residual : float or (nc,) float, largest |entry| of the condensed mismatch / D
+        (round-off when exact)
     """
     P = np.asarray(P, float)
-    rows, w, grp = _cell_rows(P, wings)
-    area = 0.5 * abs(float(np.sum(P[:, 0] * np.roll(P[:, 1], -1) - np.roll(P[:, 0], -1) * P[:, 1])))
-    plate = area * np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 2.0 * (1.0 - nu)]])
-    if len(P) == 3:
-        Rinv = np.linalg.inv(rows[:, :3])
-        K = Rinv.T @ plate @ Rinv
+    rows, w, _ = _cell_rows(P, wings)
+    x, y = P[..., 0], P[..., 1]
+    area = 0.5 * np.abs(np.sum(x * np.roll(y, -1, -1) - np.roll(x, -1, -1) * y, axis=-1))
+    unit = np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 2.0 * (1.0 - nu)]])
+    plate = area[..., None, None] * unit
+    if P.shape[-2] == 3:
+        Rinv = np.linalg.inv(rows[..., :3])
+        K = np.swapaxes(Rinv, -1, -2) @ plate @ Rinv
     else:
         Kd = np.diag(w * (4.0 / 3.0))  # the square cell's hinges, scaled by alpha below
         Md = _condensed_form(Kd, rows)
         # largest alpha with plate - alpha Md >= 0: the smallest generalised eigenvalue
-        Lc = np.linalg.cholesky(Md)
-        Li = np.linalg.inv(Lc)
-        alpha = float(np.linalg.eigvalsh(Li @ plate @ Li.T).min())
-        C = plate - alpha * Md
-        ev, V = np.linalg.eigh(0.5 * (C + C.T))
-        C = (V * np.clip(ev, 0.0, None)) @ V.T
-        L = (rows @ np.linalg.inv(rows.T @ rows))[:, :3]
-        K = alpha * Kd + L @ C @ L.T
-    K = 0.5 * (K + K.T)
-    residual = float(np.abs(_condensed_form(K, rows) - plate).max() / area)
-    return K, residual
+        Li = np.linalg.inv(np.linalg.cholesky(Md))
+        alpha = np.linalg.eigvalsh(Li @ plate @ np.swapaxes(Li, -1, -2))[..., 0]
+        C = plate - alpha[..., None, None] * Md
+        ev, V = np.linalg.eigh(0.5 * (C + np.swapaxes(C, -1, -2)))
+        C = (V * np.clip(ev, 0.0, None)[..., None, :]) @ np.swapaxes(V, -1, -2)
+        RtR = np.swapaxes(rows, -1, -2) @ rows
+        L = (rows @ np.linalg.inv(RtR))[..., :3]
+        K = alpha[..., None, None] * Kd + L @ C @ np.swapaxes(L, -1, -2)
+    K = 0.5 * (K + np.swapaxes(K, -1, -2))
+    mismatch = np.abs(_condensed_form(K, rows) - plate).max(axis=(-1, -2)) / area
+    return K, (float(mismatch) if P.ndim == 2 else mismatch)
 
 
 def _condensed_form(K: np.ndarray, rows: np.ndarray) -> np.ndarray:
-    """(3, 3) form ``R^T K R`` in (k11, k22, k12), the centre offset (4th row entry, if
-    any) condensed out."""
-    M = rows.T @ K @ rows
-    if M.shape[0] == 4 and M[3, 3] > 1e-300:
-        return M[:3, :3] - np.outer(M[:3, 3], M[3, :3]) / M[3, 3]
-    return M[:3, :3]
+    """(..., 3, 3) form ``R^T K R`` in (k11, k22, k12), the centre offset (4th row entry, if
+    any) condensed out (``K`` (..., n, n), ``rows`` (..., n, 3 or 4))."""
+    M = np.swapaxes(rows, -1, -2) @ K @ rows
+    if M.shape[-1] == 4:
+        m33 = M[..., 3, 3]
+        ok = m33 > 1e-300
+        corr = M[..., :3, 3, None] * M[..., 3, None, :3] / np.where(ok, m33, 1.0)[..., None, None]
+        return M[..., :3, :3] - np.where(ok[..., None, None], corr, 0.0)
+    return M[..., :3, :3]
 
 
 #: a uniform curvature (k11, k22, k12) that moves every hinge of a cell (sign test)
@@ -428,13 +447,13 @@ def coupled_bending(model: BarHingeModel) -> BarHingeModel:
             )
             inv = inv.ravel()
             hid = np.concatenate([hid, diag_hid], axis=1)
-        cell_wings = [None if wings is None else wings[f] for f in first]
-        shapes = [cell_matrix(P2[f], nu, w) for f, w in zip(first, cell_wings, strict=True)]
-        K = np.array([s[0] for s in shapes])[inv]  # (nf, n, n) / D
-        residual[fids] = np.array([s[1] for s in shapes])[inv]
+        # the distinct shapes together (one batched computation, not one per shape)
+        rep_wings = None if wings is None else wings[first]
+        K_rep, res_rep = cell_matrix(P2[first], nu, rep_wings)
+        K = K_rep[inv]  # (nf, n, n) / D
+        residual[fids] = np.asarray(res_rep)[inv]
         # angle rows per cell: the representative's, scaled to the cell (rows ~ length)
-        reps = zip(first, cell_wings, strict=True)
-        rows = np.array([_cell_rows(P2[f], w)[0] for f, w in reps])[inv]
+        rows = _cell_rows(P2[first], rep_wings)[0][inv]
         rows = rows * np.sqrt(area / area[first][inv])[:, None, None]
         valid = hid >= 0
         plate_like = valid & ~crease[np.maximum(hid, 0)]

@@ -65,6 +65,32 @@ def test_every_cell_stores_the_plate_energy_of_every_uniform_curvature(name, nu)
     assert eig.min() > 1e-3 * eig.max()  # positive definite: no zero-energy angle pattern
 
 
+@pytest.mark.parametrize("size", [3, 4])
+def test_many_cells_at_once_are_each_cell_alone(size):
+    """The batched cell matrices (one computation for every distinct cell shape of a graded
+    grid) equal the matrices of the cells one by one, and each stores the plate energy."""
+    from barhinge.model.plate_hinges import _cell_rows
+
+    rng = np.random.default_rng(7)
+    base = np.array(CELLS["square" if size == 4 else "obtuse"], float)
+    P = base + 0.12 * rng.standard_normal((40, size, 2))
+    wings = None
+    if size == 4:  # neighbours' centres across the sides, some sides without one (NaN)
+        mid = 0.5 * (P + np.roll(P, -1, axis=1))
+        wings = 2 * mid - P.mean(axis=1, keepdims=True) + 0.05 * rng.standard_normal((40, 4, 2))
+        wings[::3, 1] = np.nan
+    K, residual = cell_matrix(P, 0.3, wings)
+    rows = _cell_rows(P, wings)[0]
+    for i in range(len(P)):
+        Ki, ri = cell_matrix(P[i], 0.3, None if wings is None else wings[i])
+        np.testing.assert_allclose(K[i], Ki, rtol=1e-12, atol=1e-12 * np.abs(Ki).max())
+        np.testing.assert_allclose(
+            rows[i], _cell_rows(P[i], None if wings is None else wings[i])[0]
+        )
+        assert residual[i] == pytest.approx(ri, abs=1e-12)
+    assert residual.max() < 1e-9  # every cell passes the uniform-curvature patch test
+
+
 def _navier(D: float) -> float:
     k = np.arange(1, 200, 2, dtype=float)
     M, N = np.meshgrid(k, k)
