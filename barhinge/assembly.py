@@ -25,6 +25,9 @@ import scipy.sparse as sp
 
 __all__ = ["Assembler", "element_dofs"]
 
+#: structures of added matrices whose positions an Assembler keeps (:meth:`add_entries`)
+ENTRY_STRUCTURES = 4
+
 
 def element_dofs(conn: np.ndarray) -> np.ndarray:
     """(n_el, 3 * nodes_per_element) global dof indices, xyz interleaved per node."""
@@ -169,6 +172,7 @@ class Assembler:
     def __getstate__(self) -> dict:
         state = dict(self.__dict__)
         state.pop("_flat", None)  # scratch buffer: not worth pickling
+        state.pop("_entry_cache", None)  # positions found again on the first call
         return state
 
     def force(self, element_vectors: list[np.ndarray]) -> np.ndarray:
@@ -214,13 +218,58 @@ class Assembler:
     def add_entries(self, K: sp.csr_matrix, M: sp.spmatrix) -> None:
         """Add the symmetric sparse matrix ``M``, whose entries lie in the pattern (e.g. the
         ``pattern_groups``), into ``K`` (a matrix of this pattern) in place. Only the upper
-        triangle of ``M`` is read and mirrored, so ``K`` stays exactly symmetric."""
+        triangle of ``M`` is read and mirrored, so ``K`` stays exactly symmetric.
+
+        A CSR or CSC ``M`` of a structure (format, ``indptr``, ``indices``) seen in a recent
+        call reuses that call's positions: a model adds matrices of the same structures at
+        every evaluation, and the search for their positions is made once."""
+        if sp.issparse(M) and M.format in ("csr", "csc"):
+            cached = self._entry_positions(M)
+            if cached is not None:
+                up, pos_up, strict, pos_mirror = cached
+                data = M.data
+                K.data[pos_up] += data[up]
+                K.data[pos_mirror] += data[strict]
+                return
         C = sp.triu(M, format="coo")
         C.sum_duplicates()  # one entry per position: the fancy-index adds below are exact
         r, c = C.row.astype(np.int64), C.col.astype(np.int64)
         K.data[self._positions(r, c)] += C.data
         off = r != c
         K.data[self._positions(c[off], r[off])] += C.data[off]
+
+    def _entry_positions(
+        self, M: sp.csr_matrix | sp.csc_matrix
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+        """For the entries of the CSR or CSC matrix ``M`` in storage order: (its upper-triangle
+        entries, their positions in ``data``, its strictly upper entries, the positions of
+        their mirrors), kept for the last ``ENTRY_STRUCTURES`` structures and found again when
+        a matrix of one of them comes; None where ``M`` stores a position twice (the adds
+        need one entry per position)."""
+        cache = self.__dict__.setdefault("_entry_cache", [])
+        for indptr, indices, fmt, kept in cache:
+            if (
+                fmt == M.format
+                and indptr.shape == M.indptr.shape
+                and indices.shape == M.indices.shape
+                and np.array_equal(indptr, M.indptr)
+                and np.array_equal(indices, M.indices)
+            ):
+                return kept
+        outer = np.repeat(np.arange(len(M.indptr) - 1, dtype=np.int64), np.diff(M.indptr))
+        inner = M.indices.astype(np.int64)
+        r, c = (outer, inner) if M.format == "csr" else (inner, outer)
+        up = np.flatnonzero(c >= r)
+        pos_up = self._positions(r[up], c[up])
+        strict = up[c[up] > r[up]]
+        pos_mirror = self._positions(c[strict], r[strict])
+        result = None
+        if np.unique(pos_up).size == pos_up.size:  # no position stored twice
+            result = (up, pos_up, strict, pos_mirror)
+        # a few structures (a model adds its hinge couplings and its bar couplings)
+        cache.append((M.indptr.copy(), M.indices.copy(), M.format, result))
+        del cache[:-ENTRY_STRUCTURES]
+        return result
 
     def _positions(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """Positions in ``data`` of the entries ``(rows, cols)`` of the pattern."""

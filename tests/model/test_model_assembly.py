@@ -229,6 +229,42 @@ def test_pattern_groups_hold_entries_that_add_entries_fills_symmetrically() -> N
         asm.add_entries(K, sp.csr_matrix(outside))
 
 
+def test_add_entries_reuses_the_positions_of_a_structure_it_has_seen() -> None:
+    """A matrix of the last call's structure is added through the kept positions, bitwise as
+    the first (searched) add; a matrix of another structure, or one storing a position twice,
+    is added by searching again, and still exactly."""
+    import scipy.sparse as sp
+
+    from barhinge.assembly import Assembler
+
+    rng = np.random.default_rng(3)
+    bars = np.array([[0, 1], [1, 2], [2, 3], [3, 0]])
+    asm = Assembler(4, [bars])
+    Kb = rng.normal(size=(4, 6, 6))
+    base = asm.matrix([Kb + Kb.transpose(0, 2, 1)])
+
+    def sym(mask: np.ndarray) -> sp.csr_matrix:
+        A = rng.normal(size=(12, 12)) * mask
+        return sp.csr_matrix(A + A.T)
+
+    mask = asm.pattern().toarray() * (rng.random((12, 12)) < 0.5)
+    other = mask * (rng.random((12, 12)) < 0.7)
+    for M in (sym(mask), sym(mask), sym(other), sym(mask), sym(mask).tocsc(), sym(mask).tocsc()):
+        K = base.copy()
+        asm.add_entries(K, M)
+        expected = base.toarray() + np.triu(M.toarray()) + np.triu(M.toarray(), 1).T
+        np.testing.assert_array_equal(K.toarray(), expected)
+        assert np.array_equal(K.toarray(), K.toarray().T)
+    # a CSR storing the entry (1, 1) twice: both parts are added
+    dup = sp.csr_matrix(
+        (np.array([1.0, 2.0]), np.array([1, 1]), np.array([0, 0, 2] + [2] * 10)), shape=(12, 12)
+    )
+    for _ in range(2):
+        K = base.copy()
+        asm.add_entries(K, dup)
+        assert K[1, 1] == base[1, 1] + 3.0
+
+
 def test_hinge_couplings_keep_the_scatter_maps_small() -> None:
     """Couplings of a refined panel's hinges (the coupled plate rule: several per hinge) add
     their entries to the pattern, not element matrices to the scatter maps: the maps hold no
