@@ -28,8 +28,8 @@ uses the refined stiffness and buckling factor and the finest nonlinear check.
 
 Run: ``python studies/roofs/refine.py [--quick] [--publish] [--cache=FILE]
 [--only=FAMILY,...] [--no-second-look] [--grading=P]`` (``--grading``: the sub-panels of
-parallelogram panels crowded towards their corners, ``p >= 1``, as the shell reference's facet
-meshes; ``--only``
+parallelogram panels whose creases meet at an angle crowded towards their corners, ``p >= 1``,
+as the shell reference's facet meshes, :func:`grading_of`; ``--only``
 computes those families' roofs into the cache and publishes nothing: two such runs with their
 own caches use two cores;
 ``--no-second-look`` runs no check again from the finer increment). Every level
@@ -82,17 +82,23 @@ RULE = "coupled"
 #: its membrane (``bar_calibration``): cached levels of another membrane are recomputed
 MEMBRANE = roofs.BENDING_RULES[RULE].get("bar_calibration", "fit")
 #: sub-panels crowded towards the panels' corners (``--grading=P``; 1: equal sub-panels;
-#: :func:`barhinge.pattern.subdivide.subdivided`), on roofs of parallelogram panels (the
-#: others are cut equally, :func:`grading_of`); cached levels of another grading are
+#: :func:`barhinge.pattern.subdivide.subdivided`), on roofs of parallelogram panels whose
+#: creases meet at an angle (the others are cut equally, :func:`grading_of`); cached levels
+#: of another grading are
 #: recomputed
 GRADING = float(next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--grading=")), 1))
 
 
 def grading_of(cp) -> float:
-    """The grading of a roof's sub-panels: ``GRADING`` where every panel is a parallelogram,
-    else 1. Graded triangles break the coupled plate rule's patch test; graded trapezoids
-    (the arched Miura's panels) passed it but converged more slowly than equal ones
-    (miura_arc 60 at m = 32: 21.9 kN/m/m graded with p = 2, 27.1 equal, shell 27.6)."""
+    """The grading of a roof's sub-panels: ``GRADING`` where every panel is a parallelogram
+    and creases of different directions meet at a vertex (the corners where the plate
+    solution concentrates, which grading resolves), else 1.
+
+    Graded triangles break the coupled plate rule's patch test; graded trapezoids (the
+    arched Miura's panels) passed it but converged more slowly than equal ones (miura_arc 60
+    at m = 32: 21.9 kN/m/m graded with p = 2, 27.1 equal, shell 27.6); the pleats' parallel
+    creases meet nowhere, and their graded strips did not converge (pleats 30 at m = 2, 4, 8,
+    16: 278, 177, 216, 295 kN/m graded, 278, 320, 343, 355 equal)."""
     X = np.asarray(cp.vertices3d, float)
     for f in cp.faces:
         if len(f) != 4:
@@ -100,7 +106,22 @@ def grading_of(cp) -> float:
         P = X[list(f)]
         if np.linalg.norm(P[0] - P[1] + P[2] - P[3]) > 1e-9 * np.linalg.norm(P[2] - P[0]):
             return 1.0
-    return GRADING
+    return GRADING if crease_corners(cp) else 1.0
+
+
+def crease_corners(cp) -> bool:
+    """Whether creases (M, V) of different directions meet at some vertex of the flat
+    pattern (directions parallel to within 1e-6 rad counted as one)."""
+    E = np.asarray(cp.edges, np.int64)[np.isin(np.asarray(cp.assignment), ("M", "V"))]
+    V = np.asarray(cp.vertices, float)[:, :2]
+    d = V[E[:, 1]] - V[E[:, 0]]
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    ends, dirs = np.concatenate([E[:, 0], E[:, 1]]), np.concatenate([d, d])
+    order = np.argsort(ends, kind="stable")
+    ends, dirs = ends[order], dirs[order]
+    # at a vertex with creases of two directions, two neighbours in this order differ
+    cross = np.abs(dirs[1:, 0] * dirs[:-1, 1] - dirs[1:, 1] * dirs[:-1, 0])
+    return bool(np.any((ends[1:] == ends[:-1]) & (cross > 1e-6)))
 
 
 #: no level above this many DOFs is run
@@ -1087,7 +1108,8 @@ def section(results: list[dict]) -> str:
             f" Every roof of the comparison table with each panel cut into m × m sub-panels"
             f" (`{RULE}` plate rule, `{MEMBRANE}` membrane"
             + (
-                f", sub-panels of parallelogram panels graded towards their corners with"
+                f", on roofs of parallelogram panels whose creases meet at an angle the"
+                f" sub-panels graded towards the panels' corners with"
                 f" p = {GRADING:g}"
                 if GRADING != 1.0
                 else ""

@@ -370,3 +370,17 @@ def test_finding_names_checks_the_finer_increment_moved(study) -> None:
     assert f"b 2 at m = {lo} (0.500, was 0.200)" in text.split("later for")[1]
     assert f"b 2 at m = {hi} (" not in text  # 0.60 against 0.61: within 5 %
     assert f"c 3 at m = {lo} (was 0.250) carry the design load" in text
+
+
+@pytest.mark.parametrize(
+    ("family", "graded"),
+    [("miura60", True), ("miura75", True), ("pleats", False), ("flat", False),
+     ("miura_arc", False), ("yoshimura", False)],
+)  # fmt: skip
+def test_grading_goes_where_creases_of_two_directions_meet(study, family, graded, monkeypatch):
+    """Sub-panels are graded only on parallelogram panels whose creases meet at an angle
+    (the Miura roofs); the pleats' parallel creases meet nowhere and keep equal sub-panels."""
+    monkeypatch.setattr(study, "GRADING", 2.0)
+    cp, _, _ = study.roofs.folded(family, study.roofs.FAMILIES[family]["states"][0])
+    assert study.crease_corners(cp) == (family not in ("pleats", "flat"))
+    assert study.grading_of(cp) == (2.0 if graded else 1.0)
