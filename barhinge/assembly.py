@@ -264,7 +264,9 @@ class Assembler:
         strict = up[c[up] > r[up]]
         pos_mirror = self._positions(c[strict], r[strict])
         result = None
-        if np.unique(pos_up).size == pos_up.size:  # no position stored twice
+        seen = np.zeros(self.nnz, bool)
+        seen[pos_up] = True
+        if np.count_nonzero(seen) == pos_up.size:  # no position stored twice
             result = (up, pos_up, strict, pos_mirror)
         # a few structures (a model adds its hinge couplings and its bar couplings)
         cache.append((M.indptr.copy(), M.indices.copy(), M.format, result))
