@@ -25,8 +25,9 @@ import scipy.sparse as sp
 
 __all__ = ["Assembler", "element_dofs"]
 
-#: structures of added matrices whose positions an Assembler keeps (:meth:`add_entries`)
-ENTRY_STRUCTURES = 4
+#: structures of added matrices whose positions an Assembler keeps (:meth:`add_entries`;
+#: the least recently used goes first)
+ENTRY_STRUCTURES = 2
 
 
 def element_dofs(conn: np.ndarray) -> np.ndarray:
@@ -243,11 +244,11 @@ class Assembler:
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
         """For the entries of the CSR or CSC matrix ``M`` in storage order: (its upper-triangle
         entries, their positions in ``data``, its strictly upper entries, the positions of
-        their mirrors), kept for the last ``ENTRY_STRUCTURES`` structures and found again when
-        a matrix of one of them comes; None where ``M`` stores a position twice (the adds
-        need one entry per position)."""
+        their mirrors), kept for the ``ENTRY_STRUCTURES`` most recently used structures and
+        found again when a matrix of one of them comes; None where ``M`` stores a position
+        twice (the adds need one entry per position)."""
         cache = self.__dict__.setdefault("_entry_cache", [])
-        for indptr, indices, fmt, kept in cache:
+        for i, (indptr, indices, fmt, kept) in enumerate(cache):
             if (
                 fmt == M.format
                 and indptr.shape == M.indptr.shape
@@ -255,6 +256,7 @@ class Assembler:
                 and np.array_equal(indptr, M.indptr)
                 and np.array_equal(indices, M.indices)
             ):
+                cache.append(cache.pop(i))  # the most recently used last
                 return kept
         outer = np.repeat(np.arange(len(M.indptr) - 1, dtype=np.int64), np.diff(M.indptr))
         inner = M.indices.astype(np.int64)
@@ -267,8 +269,15 @@ class Assembler:
         seen = np.zeros(self.nnz, bool)
         seen[pos_up] = True
         if np.count_nonzero(seen) == pos_up.size:  # no position stored twice
-            result = (up, pos_up, strict, pos_mirror)
-        # a few structures (a model adds its hinge couplings and its bar couplings)
+            itype = np.int32 if max(self.nnz, M.nnz) < 2**31 - 1 else np.int64
+            result = (
+                up.astype(itype),
+                pos_up.astype(itype),
+                strict.astype(itype),
+                pos_mirror.astype(itype),
+            )
+        # the least recently used structure goes (a model adds its hinge couplings and its
+        # bar couplings, whose structure changes where entries cancel exactly)
         cache.append((M.indptr.copy(), M.indices.copy(), M.format, result))
         del cache[:-ENTRY_STRUCTURES]
         return result
