@@ -29,6 +29,7 @@ uses the refined stiffness and buckling factor and the finest nonlinear check.
 Run: ``python studies/roofs/refine.py [--quick] [--publish] [--cache=FILE]
 [--only=FAMILY,...] [--no-second-look] [--grading=P]`` (``--grading``: the sub-panels of
 parallelogram panels whose creases meet at an angle crowded towards their corners, ``p >= 1``,
+default 2,
 as the shell reference's facet meshes, :func:`grading_of`; ``--only``
 computes those families' roofs into the cache and publishes nothing: two such runs with their
 own caches use two cores;
@@ -81,12 +82,13 @@ TOL = roofs.REFINE_TOL
 RULE = "coupled"
 #: its membrane (``bar_calibration``): cached levels of another membrane are recomputed
 MEMBRANE = roofs.BENDING_RULES[RULE].get("bar_calibration", "fit")
-#: sub-panels crowded towards the panels' corners (``--grading=P``; 1: equal sub-panels;
+#: sub-panels crowded towards the panels' corners (``--grading=P``, default 2, the published
+#: study; 1: equal sub-panels;
 #: :func:`barhinge.pattern.subdivide.subdivided`), on roofs of parallelogram panels whose
 #: creases meet at an angle (the others are cut equally, :func:`grading_of`); cached levels
 #: of another grading are
 #: recomputed
-GRADING = float(next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--grading=")), 1))
+GRADING = float(next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--grading=")), 2))
 
 
 def grading_of(cp) -> float:
@@ -1006,6 +1008,8 @@ def shell_finding(results: list[dict]) -> str:
             + (
                 " (all of them stopped at the DOF budget, finding 1)"
                 if all(not r["refined"] for r in off)
+                else " (all of them refined to 2 %)"
+                if all(r["refined"] for r in off)
                 else " ("
                 + ", ".join(lab(r) for r in off if r["refined"])
                 + " refined to 2 %, the others stopped at the DOF budget, finding 1)"
@@ -1102,13 +1106,15 @@ def section(results: list[dict]) -> str:
         [
             START,
             "",
-            "Written by `python studies/roofs/refine.py --publish` (every level is kept in"
+            "Written by `python studies/roofs/refine.py --publish"
+            + (f" --grading={GRADING:g}" if GRADING != 2.0 else "")
+            + "` (every level is kept in"
             " `studies/roofs/refine_cache.json` as it is computed, so an interrupted run"
             " resumes; data: [roofs_refined.csv](roofs_refined.csv))."
             f" Every roof of the comparison table with each panel cut into m × m sub-panels"
             f" (`{RULE}` plate rule, `{MEMBRANE}` membrane"
             + (
-                f", on roofs of parallelogram panels whose creases meet at an angle the"
+                f"; on roofs of parallelogram panels whose creases meet at an angle,"
                 f" sub-panels graded towards the panels' corners with"
                 f" p = {GRADING:g}"
                 if GRADING != 1.0
