@@ -112,10 +112,11 @@ def _cell_rows(P: np.ndarray, wings: np.ndarray | None = None):
 
     ``P`` (k, 2) or, for many cells of one size at once, (nc, k, 2); the rows are then
     (nc, n, 4) (the weights and groups are the same for every cell of a size).
-    ``wings`` (4, 2) or (nc, 4, 2), quads only: the neighbour cell's centre node across each
-    side, in the cell's plane; by default (and where a row is NaN) the point reflection of
-    the cell's own centre through the side's midpoint (exact on a grid of equal
-    parallelograms)."""
+    ``wings`` (k, 2) or (nc, k, 2): the neighbour cell's wing node across each side, in the
+    cell's plane (quads: its centre node; triangles: its corner opposite the side); by
+    default (and where a row is NaN) the point reflection of the cell's own centre (quads) or
+    opposite corner (triangles) through the side's midpoint (exact on a grid of equal
+    parallelograms and on a barycentric grid of equal triangles)."""
     P = np.asarray(P, float)
     rows, w, grp = [], [], []
     if P.shape[-2] == 4:
@@ -137,7 +138,11 @@ def _cell_rows(P: np.ndarray, wings: np.ndarray | None = None):
     else:
         for i in range(3):
             a, b, o = P[..., i, :], P[..., (i + 1) % 3, :], P[..., (i + 2) % 3, :]
-            rows.append(_angle_row(a, b, [(o, 0.0), (a + b - o, 0.0)]))
+            nb = a + b - o
+            if wings is not None:
+                wi = np.asarray(wings, float)[..., i, :]
+                nb = np.where(np.isfinite(wi).all(axis=-1)[..., None], wi, nb)
+            rows.append(_angle_row(a, b, [(o, 0.0), (nb, 0.0)]))
             w.append(0.5)
             grp.append(i)
     return np.stack(rows, axis=-2), np.array(w), np.array(grp)
@@ -326,7 +331,7 @@ def cell_matrix(
     wherever ``K_d`` is (no zero-energy mode beyond the rigid ones).
 
     ``P`` (k, 2) is one cell; (nc, k, 2) are many cells of one size at once (``wings``
-    then (nc, 4, 2)), computed together.
+    then (nc, k, 2)), computed together.
 
     Returns
     -------
@@ -385,11 +390,12 @@ def coupled_bending(model: BarHingeModel) -> BarHingeModel:
     own rotation, which the plate energy must not see. Cells on a crease or a free edge keep
     the principal part of their matrix (positive semi-definite); their crease hinge gets the
     cell's diagonal entry as its plate strip. Needs N5B8 quadrilateral or triangular faces.
-    A quadrilateral cell takes its neighbours' centre nodes where they are (any grid of
-    quadrilaterals, e.g. a bilinear grid of a trapezoid); a triangular cell assumes that the
-    neighbour across a side is its point reflection (the barycentric grids of
-    ``barhinge.pattern.subdivide.subdivided``). Where the model's hinge angles disagree with
-    the cells' rows, a warning names the largest mismatch.
+    A cell takes its neighbours' wing nodes across its flat sides where they are (a
+    quadrilateral its neighbours' centre nodes, a triangle their opposite corners): any grid,
+    e.g. a bilinear grid of a trapezoid or a graded grid
+    (``barhinge.pattern.subdivide.subdivided`` with ``grading``); across a crease or a free
+    edge it takes the point reflection of its own. Where the model's hinge angles disagree
+    with the cells' rows, a warning names the largest mismatch.
     """
     from barhinge.kernels.geometry import hinge_angle_derivatives
 
@@ -424,31 +430,30 @@ def coupled_bending(model: BarHingeModel) -> BarHingeModel:
         a, b = F, np.roll(F, -1, axis=1)
         e = eorder[np.searchsorted(ekey, np.minimum(a, b) * nv + np.maximum(a, b), sorter=eorder)]
         hid = hinge_of_edge[e]  # (nf, size), -1 on boundary edges
-        wings = None
+        # the neighbour's wing node across every flat side, in the cell's plane (quads:
+        # its centre node; triangles: its corner opposite the side): the grid need not be
+        # point-symmetric (graded grids; quads' centres sit where their diagonals cross)
+        side = np.maximum(hid, 0)
         if size == 4:
             diag_hid = _diagonal_hinges(model, fids, F)
-            # the neighbour's centre node across every flat side, in the cell's plane: the
-            # grid need not be point-symmetric (quads' centres sit where their diagonals cross)
-            own = np.maximum(h[diag_hid[:, 0], 0], h[diag_hid[:, 0], 1])  # centre node
-            side = np.maximum(hid, 0)
-            wing = np.where(h[side, 2] == own[:, None], h[side, 3], h[side, 2])  # (nf, 4)
-            origin, e1, e2 = _cell_frames(X, F)
-            R = X[wing] - origin[:, None]
-            wings = np.stack(
-                [np.einsum("fki,fi->fk", R, e1), np.einsum("fki,fi->fk", R, e2)], axis=-1
-            )
-            wings[~((hid >= 0) & flat_line[side])] = np.nan
-            scale = np.sqrt(area)[:, None, None]
-            key = np.round(
-                np.concatenate([P2, np.nan_to_num(wings, nan=1e9)], 1) / scale, SHAPE_DIGITS
-            )
-            _, first, inv = np.unique(
-                key.reshape(len(fids), -1), axis=0, return_index=True, return_inverse=True
-            )
-            inv = inv.ravel()
+            own = np.maximum(h[diag_hid[:, 0], 0], h[diag_hid[:, 0], 1])[:, None]  # centre
+        else:
+            own = np.roll(F, -2, axis=1)  # the corner opposite side i (F_i -> F_i+1)
+        wing = np.where(h[side, 2] == own, h[side, 3], h[side, 2])  # (nf, size)
+        origin, e1, e2 = _cell_frames(X, F)
+        R = X[wing] - origin[:, None]
+        wings = np.stack([np.einsum("fki,fi->fk", R, e1), np.einsum("fki,fi->fk", R, e2)], -1)
+        wings[~((hid >= 0) & flat_line[side])] = np.nan
+        scale = np.sqrt(area)[:, None, None]
+        key = np.round(np.concatenate([P2, np.nan_to_num(wings, nan=1e9)], 1) / scale, SHAPE_DIGITS)
+        _, first, inv = np.unique(
+            key.reshape(len(fids), -1), axis=0, return_index=True, return_inverse=True
+        )
+        inv = inv.ravel()
+        if size == 4:
             hid = np.concatenate([hid, diag_hid], axis=1)
         # the distinct shapes together (one batched computation, not one per shape)
-        rep_wings = None if wings is None else wings[first]
+        rep_wings = wings[first]
         K_rep, res_rep = cell_matrix(P2[first], nu, rep_wings)
         K = K_rep[inv]  # (nf, n, n) / D
         residual[fids] = np.asarray(res_rep)[inv]
@@ -470,7 +475,7 @@ def coupled_bending(model: BarHingeModel) -> BarHingeModel:
         pair_c.append(c[ok])
     if worst > 1e-6:
         logger.warning(
-            "coupled bending: hinge angles differ from the point-reflection grid by up to "
+            "coupled bending: hinge angles differ from the cells' rows by up to "
             "%.2g (relative); those cells do not pass the patch test exactly",
             worst,
         )
@@ -500,7 +505,8 @@ def _angle_signs(
     X: np.ndarray, F: np.ndarray, h: np.ndarray, grad: np.ndarray, hid: np.ndarray, rows
 ) -> tuple[np.ndarray, float]:
     """(nf, n) sign of each model hinge angle against the cell's linearised angle row, and
-    the largest relative mismatch of their magnitudes (0 on point-reflection grids)."""
+    the largest relative mismatch of their magnitudes (0 where the rows use the model's own
+    wing nodes)."""
     P = X[F]
     nrm = np.cross(P, np.roll(P, -1, axis=1)).sum(axis=1)
     nrm /= np.linalg.norm(nrm, axis=1)[:, None]

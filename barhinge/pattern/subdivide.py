@@ -14,10 +14,13 @@ ends): every grid coordinate ``x = i/m`` becomes ``g(x) = x^p / (x^p + (1 - x)^p
 (:func:`corner_graded`). ``g(1 - x) = 1 - g(x)``, so an edge is cut at the same points from
 either end and neighbouring faces share them; a parallelogram's cells stay parallelograms.
 The shell reference of :mod:`barhinge.model.shell` grades its facet meshes the same way.
-Triangles are not graded (a pattern with triangular faces and ``grading > 1`` is refused):
-a graded barycentric grid has cells of different shapes side by side, on which the coupled
-plate rule (:func:`barhinge.model.plate_hinges.coupled_bending`) no longer passes its patch
-test (a graded Yoshimura roof came out twice as stiff as its refined limit).
+Triangles are not graded (a pattern with triangular faces and ``grading > 1`` is refused).
+The coupled plate rule (:func:`barhinge.model.plate_hinges.coupled_bending`) reads the
+neighbours of a graded triangle grid where they are and passes its patch test there, but
+its triangles converge at first order even on a smooth plate, and a graded barycentric grid
+(every barycentric coordinate graded as above and renormalised) converged more slowly than
+the equal one on Navier's simply supported square plate: the cells it crowds along the
+edges are slender.
 """
 
 from __future__ import annotations

@@ -96,7 +96,8 @@ def grading_of(cp) -> float:
     and creases of different directions meet at a vertex (the corners where the plate
     solution concentrates, which grading resolves), else 1.
 
-    Graded triangles break the coupled plate rule's patch test; graded trapezoids (the
+    Triangles are not graded (:mod:`barhinge.pattern.subdivide`: the coupled rule passes
+    its patch test on graded triangles but converges more slowly there); graded trapezoids (the
     arched Miura's panels) passed it but converged more slowly than equal ones (miura_arc 60
     at m = 32: 21.9 kN/m/m graded with p = 2, 27.1 equal, shell 27.6); the pleats' parallel
     creases meet nowhere, and their graded strips did not converge (pleats 30 at m = 2, 4, 8,
