@@ -1,7 +1,7 @@
 """One-command scaling table: Miura n x n folds, time, factorisations and memory against DOF.
 
 Run:  python benchmarks/scaling.py [--sizes 10 20 40] [--steps 50] [--pieces 200]
-      [--publish]
+      [--rows FILE [--fresh]] [--publish]
 
 Every size runs in a fresh process (``--one n``), so that its peak resident memory
 (``ru_maxrss``) is its own. A size is the fold of ``bench_solver.miura_scene`` (Miura n x n,
@@ -17,6 +17,12 @@ model build, the first assembly of the tangent (with the process's peak memory a
 and one Newton iteration's factorisation + solve at the flat state; where that sheet is not
 folded in full, the whole fold is *extrapolated* (stated as such in the table) from the
 measured per-iteration time times the iterations per step of the largest size run in full.
+
+``--rows FILE`` keeps every finished size's row in the JSON file ``FILE`` as it completes,
+and a later run takes the sizes already there from it (same ``--steps``) instead of folding
+them again (``--fresh`` folds them again and replaces them): the 200 x 200 fold can run on
+its own and the other sizes later, on a quiet machine, and one ``--publish`` writes them
+together.
 
 ``--publish`` writes the tables into docs/solver-performance.md (between the ``scaling``
 markers), using :func:`barhinge._publish.write_between`.
@@ -343,6 +349,33 @@ def ten_million_lines(big: dict | None, rows: list[dict], steps: int) -> list[st
     ]
 
 
+def _row_key(n: int, material: str, steps: int) -> str:
+    return f"{material}:{n}:{steps}"
+
+
+def _load_rows(path: str | None) -> dict:
+    """The rows kept in ``path`` (``--rows``); empty when there is none yet."""
+    if path is None or not Path(path).exists():
+        return {}
+    try:
+        kept = json.loads(Path(path).read_text(encoding="utf-8"))
+    except json.JSONDecodeError as exc:
+        raise SystemExit(f"--rows {path}: not a rows file of this script ({exc})") from None
+    if not isinstance(kept, dict):
+        raise SystemExit(f"--rows {path}: not a rows file of this script")
+    return kept
+
+
+def _keep_row(path: str | None, kept: dict, key: str, row: dict) -> None:
+    """Add ``row`` to the rows file (written whole, through a temporary file)."""
+    if path is None:
+        return
+    kept[key] = row
+    tmp = Path(f"{path}.tmp")
+    tmp.write_text(json.dumps(kept, indent=1), encoding="utf-8")
+    os.replace(tmp, path)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--sizes", type=int, nargs="*", default=[10, 20, 40, 70])
@@ -358,6 +391,8 @@ def main() -> None:
     ap.add_argument("--one", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--material", default="quasi-rigid", help=argparse.SUPPRESS)
     ap.add_argument("--one-pieces", type=int, help=argparse.SUPPRESS)
+    ap.add_argument("--rows", help="JSON file keeping every finished size's row (resumes)")
+    ap.add_argument("--fresh", action="store_true", help="fold sizes kept in --rows again")
     ap.add_argument("--publish", action="store_true", help="write into docs/")
     a = ap.parse_args()
     if a.one is not None:
@@ -368,14 +403,22 @@ def main() -> None:
         return
 
     rows, failed = [], []
+    kept = _load_rows(a.rows)
     for mat in a.materials:
         for n in a.sizes if mat == "quasi-rigid" else a.compliant_sizes:
+            key = _row_key(n, mat, a.steps)
+            if key in kept and not a.fresh:
+                rows.append(kept[key])
+                print(f"n = {n}, {mat}: row kept in {a.rows}", file=sys.stderr, flush=True)
+                continue
             try:
-                rows.append(_child(["--one", str(n), "--steps", str(a.steps), "--material", mat]))
+                row = _child(["--one", str(n), "--steps", str(a.steps), "--material", mat])
             except RuntimeError as exc:  # the other sizes still run and are published
                 print(f"error: n = {n}, {mat}: {exc}", file=sys.stderr, flush=True)
                 failed.append(f"n = {n}, {mat}: {exc}")
                 continue
+            rows.append(row)
+            _keep_row(a.rows, kept, key, row)
             print(fold_table(rows, a.steps)[-1], flush=True)
     lines = fold_table(rows, a.steps) + exponent_lines(rows)
     lines += [f"\n**Not completed**: {f}" for f in failed]
