@@ -61,6 +61,7 @@ def bordered_matrix(n: int):
     import barhinge as bh
     from barhinge.linalg.backends import get_backend
     from barhinge.solver.bordered import BorderedSystem, Timer, actuator_terms
+    from barhinge.solver.context import auto_augmentation
 
     sc = miura_scene(n, 0.0, 50)
     model = sc.model
@@ -70,8 +71,7 @@ def bordered_matrix(n: int):
         raise SystemExit(f"n = {n}: the folded sheet's nodes do not match the flat sheet's")
     ev = model.evaluate(X, tangent=True)
     terms = actuator_terms(model, X, sc.actuator_hinges())
-    kd = float(np.mean(np.abs(ev.K.diagonal())[terms.dofs.ravel()]))
-    p = kd / float(np.mean(np.sum(terms.grad**2, axis=1)))
+    p, _ = auto_augmentation(ev.K, terms)
     sysm = BorderedSystem(get_backend("pardiso"), ~sc.fixed.ravel(), terms.dofs, Timer())
     sysm.set_operator(ev.K, terms, np.zeros(len(terms.dofs)), p, factorize=True)
     return sysm._kkt_matrix(upper=True).copy(), int(model.n_dof)
@@ -94,10 +94,9 @@ def pardiso_figures(U) -> dict:
         times = []
         for _ in range(3):
             t0 = time.perf_counter()
-            b.factorize(U, upper=True)
+            f = b.factorize(U, upper=True)
             times.append(time.perf_counter() - t0)
         mb = b.factor_bytes() / 2**20
-        f = b.factorize(U, upper=True)
         rhs = np.random.default_rng(0).uniform(-1.0, 1.0, U.shape[0])
         x = f.solve(rhs)
     A = U + sp.triu(U, k=1).T

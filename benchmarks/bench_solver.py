@@ -36,6 +36,7 @@ from barhinge.model.material import Material
 from barhinge.model.model import BarHingeModel
 from barhinge.scene import Scene
 from barhinge.solver.bordered import BorderedSystem, Timer, actuator_terms
+from barhinge.solver.context import auto_augmentation
 
 
 def _stiffness_model(cp, material: str) -> BarHingeModel:
@@ -99,8 +100,7 @@ def bare_factorisation(
     T = actuator_terms(model, X, scene.actuator_hinges())
     # the solver's own augmentation ("auto": mean diagonal on the actuator DOFs over the
     # mean |grad rho|^2) and multipliers: the very matrix of its last iteration
-    kd = float(np.mean(np.abs(K.diagonal())[T.dofs.ravel()]))
-    p = kd / float(np.mean(np.sum(T.grad**2, axis=1)))
+    p, _ = auto_augmentation(K, T)
     b = get_backend(backend)
     sysm = BorderedSystem(b, free, T.dofs, Timer())
     sysm.set_operator(K, T, mu, p)  # factorises once (warm-up)

@@ -35,7 +35,7 @@ ORDERINGS = {0: "AMD", 1: "user", 2: "AMF", 3: "SCOTCH", 4: "PORD", 5: "METIS", 
 
 def load_rows(path: str, rstart: int, rend: int):
     """(indptr, indices, data) of rows ``rstart:rend`` of the full symmetric matrix whose
-    upper triangle is stored in ``path``, and its size."""
+    upper triangle is stored in ``path``."""
     import scipy.sparse as sp
 
     z = np.load(path)
@@ -44,7 +44,7 @@ def load_rows(path: str, rstart: int, rend: int):
     lower = sp.triu(U, k=1, format="csr").T.tocsr()
     A = (U + lower).tocsr()[rstart:rend]
     A.sort_indices()
-    return A.indptr.astype(PETSc.IntType), A.indices.astype(PETSc.IntType), A.data, n
+    return A.indptr.astype(PETSc.IntType), A.indices.astype(PETSc.IntType), A.data
 
 
 def main() -> None:
@@ -54,7 +54,7 @@ def main() -> None:
     n = int(np.load(path)["shape"][0])
     rows = PETSc.Vec().createMPI(n, comm=comm)
     rstart, rend = rows.getOwnershipRange()
-    indptr, indices, data, _ = load_rows(path, rstart, rend)
+    indptr, indices, data = load_rows(path, rstart, rend)
     A = PETSc.Mat().createAIJ(((rend - rstart, n), (rend - rstart, n)), comm=comm)
     A.setPreallocationCSR((indptr, indices, data))
     A.setOption(PETSc.Mat.Option.SYMMETRIC, True)

@@ -137,16 +137,12 @@ class SolveContext:
     def _auto_penalty(self, K: Any, terms: ActuatorTerms) -> float:
         a = self.opts.augmentation
         self.c_scale = 1.0
-        d = np.abs(K.diagonal())
         if not self.n_act:
             return 0.0
-        dd = d[terms.dofs.ravel()]
-        kd = float(np.mean(dd)) if dd.size and np.mean(dd) > 0 else 1.0
-        g2 = float(np.mean(np.sum(terms.grad**2, axis=1)))
-        self.c_scale = kd / np.sqrt(g2) if g2 > 0 else kd
+        penalty, self.c_scale = auto_augmentation(K, terms)
         if a != "auto":
             return float(a)
-        return kd / g2 if g2 > 0 else kd
+        return penalty
 
     def factorize(self, e: Evaluation, st: State, reuse: bool = False) -> None:
         """Make the tangent at ``st`` the operator of the bordered system and factorise it
@@ -169,6 +165,19 @@ class SolveContext:
             self.factorize(e, st, reuse)
         except SingularMatrixError as exc:
             raise IncrementFailed(f"singular tangent ({exc})", res) from None
+
+
+def auto_augmentation(K: Any, terms: ActuatorTerms) -> tuple[float, float]:
+    """The solver's ``augmentation = "auto"`` for the tangent ``K`` and the actuators
+    ``terms``: (penalty ``p`` of ``K + p G^T G``, the mean stiffness on the actuators' DOFs
+    over the mean ``|grad rho|^2``, in force x length; the row scale of the actuator
+    constraints, that stiffness over the root of that mean)."""
+    dd = np.abs(K.diagonal())[terms.dofs.ravel()]
+    kd = float(np.mean(dd)) if dd.size and np.mean(dd) > 0 else 1.0
+    g2 = float(np.mean(np.sum(terms.grad**2, axis=1)))
+    if g2 > 0:
+        return kd / g2, kd / np.sqrt(g2)
+    return kd, kd
 
 
 def _wrap(a: np.ndarray) -> np.ndarray:
