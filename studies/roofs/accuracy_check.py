@@ -15,7 +15,8 @@ Run: ``python studies/roofs/accuracy_check.py [--publish] [--cache=FILE] [--shel
 [ROOF:STATE ...]``. The chooser's levels are kept in ``--cache`` (default
 ``accuracy_cache.json`` beside this file, not versioned) as they are computed, so an
 interrupted run resumes; the shell references are read from ``--shells`` (default
-``refine_cache.json``, the refine study's cache) and computed where missing. ``--publish``
+``refine_cache.json``, the refine study's cache) or ``--cache``, and computed where missing at
+the refine study's levels (:func:`roofs.shell_reference`; kept in ``--cache``). ``--publish``
 writes the table into docs/roofs.md.
 """
 
@@ -62,15 +63,14 @@ def roof_scene(family: str, state: float):
 
 
 def shell_of(fam: str, state: float, shells: dict[str, Any]) -> tuple[float, float]:
-    """(shell reference, its relative uncertainty) of a roof, from the refine study's cache
-    ``shells`` (computed and added to it when missing)."""
+    """(shell reference, its relative uncertainty) of a roof, from ``shells`` (the refine
+    study's cache, or this check's) or computed at the refine study's full levels
+    (:func:`roofs.shell_reference`) and added to it when missing."""
     from barhinge.analysis.accuracy import richardson
 
     key = f"shell|{fam}|{state:g}"
     if key not in shells:
-        import refine
-
-        shells[key] = refine.shell_reference(fam, state)
+        shells[key] = roofs.shell_reference(fam, state)
     ref, _, corr = richardson([s["stiffness"] for s in shells[key]])
     return ref, abs(corr / ref) if math.isfinite(corr) else math.inf
 
@@ -236,7 +236,12 @@ def main(argv: list[str]) -> None:
     roof_rows: list[dict] = []
     for fam, st in roof_list:
         key = f"{fam}|{st:g}"
+        skey = f"shell|{key}"
+        if skey not in shell_store and skey in store:
+            shell_store[skey] = store[skey]
         ref, unc = shell_of(fam, st, shell_store)
+        store[skey] = shell_store[skey]  # kept with the chooser's levels (written below)
+        cache.write_text(json.dumps(store, indent=0))
         if not unc <= SHELL_TOL:
             print(f"{key}: shell reference not settled ({100 * unc:.1f} %), left out", flush=True)
             continue

@@ -142,11 +142,11 @@ NONLINEAR_LEVELS = (2, 4) if QUICK else (4, 8)
 NONLINEAR_STEPS, FINE_STEPS = 10, 40
 #: ``--no-second-look``: publish the cached checks as they are (no check is run again)
 SECOND_LOOK = "--no-second-look" not in sys.argv
-#: the shell reference of every roof (:func:`roofs.shell_level`, facet meshes graded towards
-#: the corners): these levels, then further until its Richardson estimate settles or the next
-#: level would exceed ``SHELL_DOF_BUDGET`` DOFs
-SHELL_LEVELS = (2, 3, 4) if QUICK else (1, 2, 3, 4, 5)
-SHELL_DOF_BUDGET = 60_000 if QUICK else 4_000_000
+#: the shell reference of every roof (:func:`roofs.shell_reference`, facet meshes graded
+#: towards the corners): these levels, then further until its Richardson estimate settles or
+#: the next level would exceed ``SHELL_DOF_BUDGET`` DOFs
+SHELL_LEVELS = (2, 3, 4) if QUICK else roofs.SHELL_LEVELS
+SHELL_DOF_BUDGET = 60_000 if QUICK else roofs.SHELL_DOF_BUDGET
 #: a shell reference counts when it is settled to within this (relative uncertainty)
 SHELL_TOL = 0.05
 
@@ -327,16 +327,9 @@ def refine(fam: str, state: float, done: list[dict], save=lambda rows: None) -> 
 
 
 def shell_reference(fam: str, state: float) -> list[dict]:
-    """The graded shell levels of one roof (``SHELL_LEVELS``, then refined further until
-    they settle within ``SHELL_DOF_BUDGET``; :func:`roofs.shell_extended`)."""
-    import barhinge as bh
-
-    cp, flat_xy, _ = roofs.folded(fam, state)
-    sv, se = roofs.support_lines(cp, flat_xy, roofs.FAMILIES[fam]["axis"])
-    base = bh.BarHingeModel.from_pattern(cp, "N5B8", roofs.material())
-    ck = roofs.crease_stiffness_per_length(base)
-    rows = [roofs.shell_level(cp, sv, se, r, ck, grading=roofs.SHELL_GRADING) for r in SHELL_LEVELS]
-    return roofs.shell_extended(cp, sv, se, ck, rows, SHELL_DOF_BUDGET)
+    """The graded shell levels of one roof at this run's ``SHELL_LEVELS`` and
+    ``SHELL_DOF_BUDGET`` (:func:`roofs.shell_reference`)."""
+    return roofs.shell_reference(fam, state, SHELL_LEVELS, SHELL_DOF_BUDGET)
 
 
 def summary(

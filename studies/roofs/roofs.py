@@ -505,6 +505,27 @@ def shell_extended(
     return rows
 
 
+#: the shell reference of every roof (:func:`shell_reference`): these levels, then further
+#: until its Richardson estimate settles or the next level would exceed ``SHELL_DOF_BUDGET``
+#: DOFs (the refine study's and the ``--accuracy`` check's, so both compare with one reference)
+SHELL_LEVELS = (1, 2, 3, 4, 5)
+SHELL_DOF_BUDGET = 4_000_000
+
+
+def shell_reference(
+    fam: str, state: float, levels: tuple[int, ...] = SHELL_LEVELS, budget: int = SHELL_DOF_BUDGET
+) -> list[dict]:
+    """The graded shell levels of one roof (``levels``, then refined further until they settle
+    within ``budget`` DOFs; :func:`shell_extended`)."""
+    import barhinge as bh
+
+    cp, flat_xy, _ = folded(fam, state)
+    sv, se = support_lines(cp, flat_xy, FAMILIES[fam]["axis"])
+    ck = crease_stiffness_per_length(bh.BarHingeModel.from_pattern(cp, "N5B8", material()))
+    rows = [shell_level(cp, sv, se, r, ck, grading=SHELL_GRADING) for r in levels]
+    return shell_extended(cp, sv, se, ck, rows, budget)
+
+
 def subdivided_roof(
     cp, sv: np.ndarray, se: np.ndarray, m: int, rule: str = "coupled", scheme: str = "N5B8",
     sheet: Any = None, grading: float = 1.0,

@@ -53,3 +53,33 @@ def test_the_table_counts_only_picks_within_their_target(check) -> None:
     assert "2 choices on 2 roofs; 1 meet their target" in text and "1 targets refused" in text
     assert text.rstrip().endswith("| **no** |")  # the rigid pick off by more than its target
     assert check.verdict(0.06, 0.05, 0.02) == "within the reference's uncertainty"
+
+
+def test_a_missing_shell_reference_is_computed_at_the_refine_study_levels(
+    check, monkeypatch
+) -> None:
+    """Without the refine study's cache the check computes the shell reference itself, at the
+    full study's levels and budget (``roofs.SHELL_LEVELS``, ``roofs.SHELL_DOF_BUDGET``), not at
+    the quick mode's that importing the study would give (three levels, 60,000 DOFs: a
+    reference left unsettled), and keeps it in the dict it was handed."""
+    import sys
+
+    roofs = check.roofs
+    assert roofs.SHELL_LEVELS == (1, 2, 3, 4, 5) and roofs.SHELL_DOF_BUDGET == 4_000_000
+    calls = []
+    levels = [{"r": r, "stiffness": 100.0 * (1.0 + 0.5**r)} for r in (1, 2, 3, 4, 5)]
+
+    def fake(fam, state, *args):
+        calls.append((fam, state, args))
+        return levels
+
+    monkeypatch.setattr(roofs, "shell_reference", fake)
+    shells: dict = {}
+    ref, unc = check.shell_of("miura60", 15.0, shells)
+    assert calls == [("miura60", 15.0, ())]  # the defaults: the full levels
+    assert shells["shell|miura60|15"] == levels
+    # Richardson on an exact order-1 sequence: the limit, and its correction from r = 5
+    assert ref == pytest.approx(100.0, rel=1e-9) and unc == pytest.approx(0.5**5, rel=1e-9)
+    assert "refine" not in sys.modules  # the refine study's quick run is not started
+    check.shell_of("miura60", 15.0, shells)
+    assert len(calls) == 1  # read back
