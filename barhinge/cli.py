@@ -373,6 +373,16 @@ def fold_cmd(
             "form (default: form for a scene driven by actuators alone, else stiffness).",
         ),
     ] = "",
+    accuracy_max_dofs: Annotated[
+        int,
+        typer.Option(
+            "--accuracy-max-dofs",
+            min=1,
+            help="With --accuracy: the most DOFs a refined level may have (levels m = 2, 4, "
+            "8, ... are tried while they fit; a larger budget lets slowly converging "
+            "scenes meet tighter accuracies, at more time and memory).",
+        ),
+    ] = 1_500_000,
 ) -> None:
     """Fold a scene: solve it step by step, write the fold path, one summary, one step
     table and the interactive viewer (docs/outputs.md).
@@ -409,7 +419,9 @@ def fold_cmd(
             err_console.print(f"  estimated with {name}: {n_dof:,} DOFs, {seconds:.1f} s",
                               highlight=False, markup=False)  # fmt: skip
 
-        scene, choice = scene_for_accuracy(scene, accuracy, outs or None, on_level=tried)
+        scene, choice = scene_for_accuracy(
+            scene, accuracy, outs or None, on_level=tried, max_dofs=accuracy_max_dofs
+        )
         c = choice.chosen
         err_console.print(f"model for {100 * choice.accuracy:g} % in {', '.join(choice.outputs)}: "
                           f"{c.name} (estimated error {100 * c.error:.2g} %)",

@@ -2,8 +2,9 @@
 (``barhinge fold --accuracy 2%``, :func:`choose_model`).
 
 Candidates, lightest first: the rigid form (rigid kinematics; no elastic deformation), N4B5,
-N5B8, and N5B8 with every panel cut into ``m x m`` cells (``m = 2, 4, 8, 16, 32``;
-:func:`barhinge.pattern.subdivide.subdivided`, up to ``MAX_DOFS``): the refined model
+N5B8, and N5B8 with every panel cut into ``m x m`` cells (``m = 2, 4, 8, ...``, doubled while
+the level fits in ``max_dofs``, ``MAX_DOFS`` by default;
+:func:`barhinge.pattern.subdivide.subdivided`): the refined model
 (``REFINED_MODEL``) whose cells store the Kirchhoff plate energy of every uniform curvature
 (:func:`barhinge.model.plate_hinges.coupled_bending`) and the plane-stress energy of every
 uniform strain (``bar_calibration="cst"``, :mod:`barhinge.model.membrane`), the model the roof
@@ -71,8 +72,9 @@ __all__ = [
 
 #: outputs an accuracy can be asked for
 OUTPUTS = ("stiffness", "displacement", "form")
-#: subdivision levels tried, coarsest first
-LEVELS = (2, 4, 8, 16, 32)
+#: subdivision levels tried, coarsest first, while they fit in ``max_dofs`` (patterns of
+#: triangles reach m = 64 and 128 within ``MAX_DOFS``; Miura quadrilaterals about m = 32)
+LEVELS = (2, 4, 8, 16, 32, 64, 128, 256)
 #: no subdivision level with more DOFs than this is built (a linear solve of about 8 GB)
 MAX_DOFS = 1_500_000
 #: the subdivided candidates' model, as reported in a choice's summary
@@ -508,15 +510,17 @@ def scene_for_accuracy(
     accuracy: float | str,
     outputs: tuple[str, ...] | None = None,
     on_level: Callable[[str, int, float], None] | None = None,
+    max_dofs: int = MAX_DOFS,
 ):
     """(scene to run, ModelChoice): the scene rebuilt on the model :func:`choose_model` picks
     (the scene itself for the rigid form or the scene's own model). ``outputs`` default:
-    the form for a scene driven by actuators alone, else the stiffness."""
+    the form for a scene driven by actuators alone, else the stiffness; ``max_dofs``: the
+    most DOFs a refined level may have."""
     from barhinge.solver.form import form_only_model
 
     if not outputs:
         outputs = ("form",) if form_only_model(scene)[0] == "rigid" else ("stiffness",)
-    ch = choose_model(scene, accuracy, outputs, on_level=on_level)
+    ch = choose_model(scene, accuracy, outputs, on_level=on_level, max_dofs=max_dofs)
     c = ch.chosen
     if c.name == "rigid" or (c.m == 1 and c.scheme == scene.model.scheme):
         return scene, ch

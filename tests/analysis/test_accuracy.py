@@ -274,10 +274,13 @@ def test_cli_fold_accuracy_on_a_loaded_scene(tmp_path, capsys):
     choice = json.loads((out / "summary.json").read_text())["model_choice"]
     assert choice["refined_model"].startswith("N5B8") and choice["model"].startswith("N5B8 m=")
     assert all(c["estimated_error"]["stiffness"] > 0.10 for c in choice["candidates"][:3])
+    strict = ["--accuracy", "0.01%", "--accuracy-max-dofs", "50000"]
     with pytest.raises(SystemExit) as exc:
-        main(["fold", str(scene), "--out", str(tmp_path / "strict"), "--accuracy", "0.01%"])
+        main(["fold", str(scene), "--out", str(tmp_path / "strict"), *strict])
     assert exc.value.code == 3
-    assert "no model up to m = 32 meets the accuracy 0.01 %" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "no model up to m = 32 meets the accuracy 0.01 %" in err  # m = 64: 86,979 DOFs
+    assert "estimated with N5B8 m=64" not in err
 
 
 def test_the_asymptotic_range_is_checked_before_an_extrapolation_is_trusted():
@@ -294,3 +297,34 @@ def test_the_asymptotic_range_is_checked_before_an_extrapolation_is_trusted():
     assert in_asymptotic_range([3 + 2 * m**-1.5 for m in (2, 4, 8, 16)])
     # a rate that changes from 1 to 3: not yet asymptotic
     assert not in_asymptotic_range([10.0, 9.0, 8.5, 8.4375])
+
+
+def test_levels_are_refined_while_they_fit_in_the_dof_budget(monkeypatch):
+    """The chooser refines past m = 32 where the DOF budget allows it. On a sequence of
+    known first order, ``k(m) = 100 (1 + 1/m)``, Richardson's limit is exact and its
+    correction from m is ``100/m``, so a level's estimated error is ``2/m``: 2 % is first met
+    at m = 128 (1.6 %), 1 % at m = 256; with the budget of m = 64 (or ``max_m = 32``) the
+    target is refused and the best estimate named."""
+    import barhinge.analysis.accuracy as acc
+
+    scene = _roof()
+
+    def fake_scene(static, m, scheme="N5B8"):
+        return (m, scheme)
+
+    def fake_response(sc):
+        m, scheme = sc
+        return {"stiffness": 100.0 * (1.0 + 1.0 / m), "displacement": 1.0 + 1.0 / m}, m
+
+    monkeypatch.setattr(acc, "subdivided_scene", fake_scene)
+    monkeypatch.setattr(acc, "_response", fake_response)
+    ch = choose_model(scene, "2%", max_dofs=10**9)
+    assert ch.chosen.m == 128
+    assert ch.chosen.error == pytest.approx(2 / 128, rel=1e-9)
+    assert [c.m for c in ch.candidates if c.m > 1][-1] == 128  # stopped where it was met
+    assert choose_model(scene, "1%", max_dofs=10**9).chosen.m == 256
+    budget_64 = acc._level_dofs(scene.model.pattern, 64)
+    with pytest.raises(bh.errors.ConvergenceError, match=r"up to m = 64 .* 3.1 %"):
+        choose_model(scene, "2%", max_dofs=budget_64)
+    with pytest.raises(bh.errors.ConvergenceError, match=r"up to m = 32 .* 6.2 %"):
+        choose_model(scene, "2%", max_m=32, max_dofs=10**9)
