@@ -445,9 +445,20 @@ def choose_model(
     ok = [c for c in cands if c.error <= acc]
     if not ok:
         best = min(cands, key=lambda c: c.error)
+        head = f"no model up to m = {levels[-1]} meets the accuracy {100 * acc:g} %"
+        if not any(math.isfinite(c.error) for c in cands if c.m > 1):
+            q = "stiffness" if "stiffness" in outs else "displacement"
+            vals = [v[q] for v in seq]
+            steps = ", ".join(
+                f"{100 * (b / a - 1):+.1f} %" for a, b in zip(vals[:-1], vals[1:], strict=True)
+            )
+            raise ConvergenceError(
+                f"{head}: the refinement is not in its asymptotic range, so no refined level's "
+                f"error can be estimated ({q} changes from m = {levels[0]} to "
+                f"{levels[len(seq) - 1]}: {steps})"
+            )
         raise ConvergenceError(
-            f"no model up to m = {levels[-1]} meets the accuracy {100 * acc:g} %: the best "
-            f"estimate is {100 * best.error:.2g} % ({best.name})"
+            f"{head}: the best estimate is {100 * best.error:.2g} % ({best.name})"
         )
     return ModelChoice(ok[0], tuple(cands), acc, outs, ref, rate, REFINED_MODEL)
 

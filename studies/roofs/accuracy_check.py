@@ -195,7 +195,7 @@ def table(roof_rows: list[dict], shells: dict[str, tuple[float, float]], act_row
         f"{n_chosen} choices on {len({(r['family'], r['state']) for r in roof_rows})} roofs; "
         f"{n_met} meet their target against the shell (counting those within the shell "
         f"reference's own uncertainty); {n_refused} targets refused (exit code 3, the best "
-        "estimate named)."
+        "estimate named, or the changes of a refinement not yet in its asymptotic range)."
         + (
             " Missed: " + "; ".join(missed) + ". Where the limit itself is off by more than the "
             "target, refinement cannot meet it: the converged bar-and-hinge roof differs from "

@@ -328,3 +328,25 @@ def test_levels_are_refined_while_they_fit_in_the_dof_budget(monkeypatch):
         choose_model(scene, "2%", max_dofs=budget_64)
     with pytest.raises(bh.errors.ConvergenceError, match=r"up to m = 32 .* 6.2 %"):
         choose_model(scene, "2%", max_m=32, max_dofs=10**9)
+
+
+def test_a_refinement_out_of_its_asymptotic_range_is_refused_with_its_changes(monkeypatch):
+    """Where no refined level's error can be estimated (changes that do not shrink like a
+    power law), the refusal says so and names the changes, not the rigid form's 100 %."""
+    import barhinge.analysis.accuracy as acc
+
+    def fake_response(sc):
+        m, _ = sc
+        return {
+            "stiffness": 100.0 * (1.0 + 0.1 * (-1) ** int(math.log2(m))),
+            "displacement": 1.0,
+        }, m
+
+    monkeypatch.setattr(acc, "subdivided_scene", lambda static, m, scheme="N5B8": (m, scheme))
+    monkeypatch.setattr(acc, "_response", fake_response)
+    with pytest.raises(bh.errors.ConvergenceError) as exc:
+        choose_model(_roof(), "10%", max_m=16, max_dofs=10**9)
+    msg = str(exc.value)
+    assert "no model up to m = 16 meets the accuracy 10 %: the refinement is not in its " in msg
+    assert "stiffness changes from m = 2 to 16: +22.2 %, -18.2 %, +22.2 %" in msg  # 90, 110, ...
+    assert "(rigid)" not in msg
