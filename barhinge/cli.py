@@ -374,15 +374,15 @@ def fold_cmd(
         ),
     ] = "",
     accuracy_max_dofs: Annotated[
-        int,
+        int | None,
         typer.Option(
             "--accuracy-max-dofs",
             min=1,
-            help="With --accuracy: the most DOFs a refined level may have (levels m = 2, 4, "
-            "8, ... are tried while they fit; a larger budget lets slowly converging "
-            "scenes meet tighter accuracies, at more time and memory).",
+            help="With --accuracy: the most DOFs a refined level may have (default 1,500,000; "
+            "levels m = 2, 4, 8, ... are tried while they fit, and a larger budget lets "
+            "slowly converging scenes meet tighter accuracies, at more time and memory).",
         ),
-    ] = 1_500_000,
+    ] = None,
 ) -> None:
     """Fold a scene: solve it step by step, write the fold path, one summary, one step
     table and the interactive viewer (docs/outputs.md).

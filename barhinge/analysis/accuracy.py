@@ -419,7 +419,9 @@ def choose_model(
         run(scheme, 1)
     levels = [m for m in LEVELS if m <= max_m and _level_dofs(scene.model.pattern, m) <= max_dofs]
     if not levels:
-        raise ConfigError(f"no subdivision level fits in max_dofs = {max_dofs} DOFs")
+        raise ConfigError(
+            f"no subdivision level fits in max_dofs = {max_dofs} DOFs (CLI: --accuracy-max-dofs)"
+        )
     seq: list[dict[str, float]] = []
     ref: dict[str, float] = {}
     rate: dict[str, float] = {}
@@ -521,17 +523,18 @@ def scene_for_accuracy(
     accuracy: float | str,
     outputs: tuple[str, ...] | None = None,
     on_level: Callable[[str, int, float], None] | None = None,
-    max_dofs: int = MAX_DOFS,
+    max_dofs: int | None = None,
 ):
     """(scene to run, ModelChoice): the scene rebuilt on the model :func:`choose_model` picks
     (the scene itself for the rigid form or the scene's own model). ``outputs`` default:
     the form for a scene driven by actuators alone, else the stiffness; ``max_dofs``: the
-    most DOFs a refined level may have."""
+    most DOFs a refined level may have (None: ``MAX_DOFS``)."""
     from barhinge.solver.form import form_only_model
 
     if not outputs:
         outputs = ("form",) if form_only_model(scene)[0] == "rigid" else ("stiffness",)
-    ch = choose_model(scene, accuracy, outputs, on_level=on_level, max_dofs=max_dofs)
+    budget = MAX_DOFS if max_dofs is None else max_dofs
+    ch = choose_model(scene, accuracy, outputs, on_level=on_level, max_dofs=budget)
     c = ch.chosen
     if c.name == "rigid" or (c.m == 1 and c.scheme == scene.model.scheme):
         return scene, ch

@@ -328,6 +328,12 @@ def test_levels_are_refined_while_they_fit_in_the_dof_budget(monkeypatch):
         choose_model(scene, "2%", max_dofs=budget_64)
     with pytest.raises(bh.errors.ConvergenceError, match=r"up to m = 32 .* 6.2 %"):
         choose_model(scene, "2%", max_m=32, max_dofs=10**9)
+    # the CLI's --accuracy-max-dofs states the default it leaves to MAX_DOFS
+    import inspect
+
+    from barhinge import cli
+
+    assert f"(default {acc.MAX_DOFS:,};" in inspect.getsource(cli.fold_cmd)
 
 
 def test_a_refinement_out_of_its_asymptotic_range_is_refused_with_its_changes(monkeypatch):
