@@ -332,19 +332,46 @@ class RigidConstraints:
             slot[keys.size :],
         )
 
-    def normal_matrix(self, J: sp.csr_matrix) -> tuple[sp.csr_matrix, np.ndarray]:
-        """``J^T J`` (n_var, n_var) and the positions of its diagonal in ``data``.
+    @cached_property
+    def _normal_sum(self) -> sp.csr_matrix:
+        """(nnz of ``J^T J``, D * D * n_cv) 0/1 matrix summing the vertices' products
+        ``c_vd . c_ve`` (row-major ``(d, e, v)``) into the entries of ``J^T J``."""
+        k_indptr, k_indices, pairs, slot, _ = self._normal_pattern
+        cols = np.flatnonzero(pairs.ravel())
+        S = sp.csr_matrix((np.ones(cols.size), (slot, cols)), shape=(k_indices.size, pairs.size))
+        S.sum_duplicates()
+        return S
+
+    @cached_property
+    def _normal_upper(self) -> tuple[sp.csr_matrix, np.ndarray, np.ndarray, np.ndarray]:
+        """The rows of :attr:`_normal_sum` for the upper triangle of ``J^T J`` and that
+        triangle's pattern: (summation matrix, indptr, indices, diagonal positions; each
+        row's diagonal entry comes first)."""
+        k_indptr, k_indices = self._normal_pattern[:2]
+        rows = np.repeat(np.arange(self.n_var), np.diff(k_indptr))
+        upper = k_indices >= rows
+        counts = np.bincount(rows[upper], minlength=self.n_var)
+        indptr = np.concatenate([[0], np.cumsum(counts)]).astype(k_indptr.dtype)
+        return self._normal_sum[upper], indptr, k_indices[upper], indptr[:-1].copy()
+
+    def normal_matrix(
+        self, J: sp.csr_matrix, *, upper: bool = False
+    ) -> tuple[sp.csr_matrix, np.ndarray]:
+        """``J^T J`` (n_var, n_var), or its upper triangle (``upper``), and the positions of
+        its diagonal in ``data``.
 
         For a Jacobian of this pattern (:meth:`jacobian_of`) the product is summed vertex by
         vertex on a pattern that never changes, so that a sparse factorisation reuses its
         ordering (4x faster than ``J.T @ J`` on a 70 x 70 Miura sheet); any other matrix
-        takes ``J.T @ J``."""
+        takes ``J.T @ J``. Every diagonal entry is stored and indices are sorted."""
         k_indptr, k_indices, pairs, slot, diag = self._normal_pattern
         indptr, indices = self._pattern_csr[:2]
         same = J.shape == (self.n_eq, self.n_var) and J.nnz == indices.size
         if not (same and np.array_equal(J.indptr, indptr) and np.array_equal(J.indices, indices)):
             K = (J.T @ J).tocsr()
             K.setdiag(K.diagonal())  # store every diagonal entry
+            if upper:
+                K = sp.triu(K, format="csr")
             K.sort_indices()
             rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
             return K, np.flatnonzero(K.indices == rows)
@@ -357,9 +384,11 @@ class RigidConstraints:
             for e in range(d, D):
                 G[d, e] = c[d, 0] * c[e, 0] + c[d, 1] * c[e, 1] + c[d, 2] * c[e, 2]
                 G[e, d] = G[d, e]
-        data = np.bincount(slot, weights=G[pairs], minlength=k_indices.size)
-        data = data.astype(float, copy=False)  # int when no vertex is constrained
-        K = sp.csr_matrix((data, k_indices, k_indptr), shape=(self.n_var, self.n_var))
+        if upper:
+            S, k_indptr, k_indices, diag = self._normal_upper
+        else:
+            S = self._normal_sum
+        K = sp.csr_matrix((S @ G.ravel(), k_indices, k_indptr), shape=(self.n_var, self.n_var))
         K.has_sorted_indices = True
         return K, diag
 
@@ -403,8 +432,11 @@ class RigidConstraints:
         (contiguous rows of length n_cv: the products run on whole rows)."""
         lv, valid, ca, sa = self._loop_t
         D, nv = lv.shape
-        r = np.where(valid, rho[np.maximum(lv, 0)], 0.0)
-        cr, sr = np.cos(r), np.sin(r)
+        # cos and sin once per crease (each sits in two loops), gathered into the slots;
+        # an empty slot turns by 0
+        at = np.maximum(lv, 0)
+        cr = np.where(valid, np.cos(rho)[at], 1.0)
+        sr = np.where(valid, np.sin(rho)[at], 0.0)
         # columns of the running product F, updated by F <- F Rx(rho_j) Rz(alpha_j)
         c0, c1, c2 = np.zeros((3, nv)), np.zeros((3, nv)), np.zeros((3, nv))
         c0[0] = c1[1] = c2[2] = 1.0

@@ -47,7 +47,14 @@ from barhinge.actuators import Actuators
 from barhinge.errors import ConfigError, ConvergenceError
 from barhinge.kinematics.constraints import RigidConstraints
 from barhinge.kinematics.dof import FLAT_TOL, _branch_direction
-from barhinge.linalg.backends import Factor, SingularMatrixError, get_backend
+from barhinge.linalg.backends import (
+    Factor,
+    LinearBackend,
+    PardisoBackend,
+    SingularMatrixError,
+    available_backends,
+    get_backend,
+)
 from barhinge.linalg.extrapolation import EXTRAPOLATION_POINTS, extrapolate
 from barhinge.linalg.nullspace import DENSE_TOL, null_space
 from barhinge.linalg.threads import threads_for_sparse
@@ -60,7 +67,7 @@ log = logging.getLogger(__name__)
 
 
 #: crease variables from which the corrector uses the fastest backend instead of SuperLU
-PARDISO_MIN_VARS = 5000
+PARDISO_MIN_VARS = 500
 
 
 @dataclasses.dataclass(frozen=True)
@@ -177,35 +184,41 @@ class RigidSolver:
         #: (DOF, rank of the actuators on it) at the first folded state, once known
         self.dof_rank: tuple[int, int] | None = None
         self._lu: Factor | None = None
-        #: which entries of the normal matrix the held actuators leave (for a pattern, free set)
-        self._keep = np.zeros(0, bool)
-        self._mask_of: tuple[object, object] = (None, None)
-        # PARDISO pays from ~5 000 crease variables on (70 x 70 Miura, 38 920: 239 -> 95 ms
-        # per step; 20 x 20, 3 120: no gain); below, SuperLU's exact LU also lands nearer
-        # the exact flat state when a path crosses it (a bifurcation, where the closure
-        # residual is quadratic in the distance and any landing within tolerance converges)
-        self._backend = get_backend("auto" if rc.n_var >= PARDISO_MIN_VARS else "superlu")
+        #: entries of the normal matrix (or of its upper triangle) the held actuators
+        #: remove, with the pattern and free set they were found for
+        self._drops: dict[bool, tuple[object, object, np.ndarray | None]] = {}
+        # PARDISO set for normal equations pays from a few hundred crease variables on
+        # (Miura sheets, ms per step: 760 creases 2.1 -> 1.1, 3 120: 6.6 -> 2.1); below,
+        # SuperLU spares a small fold the loading of MKL
+        self._backend = _normal_backend(rc.n_var)
         self.iterations = 0
         self.last_guess: np.ndarray | None = None
 
     # ---------------------------------------------------------------- linear algebra
     def _held_normal(
-        self, J: sp.csr_matrix, shift: np.ndarray | float = 0.0, *, regularise: bool = False
+        self,
+        J: sp.csr_matrix,
+        shift: np.ndarray | float = 0.0,
+        *,
+        regularise: bool = False,
+        upper: bool = False,
     ) -> sp.csr_matrix:
         """``D (J^T J + diag(shift)) D + (I - D)`` with ``D`` the free creases (the held
         actuators' rows and columns replaced by the identity), on the constraints' fixed
-        pattern (a factorisation reuses its ordering). ``regularise`` adds a tiny
-        stiffness-weighted shift, ``1e-12`` of the largest diagonal entry of ``J^T J``."""
-        K, diag = self.rc.normal_matrix(J)
+        pattern (a factorisation reuses its ordering); its upper triangle with ``upper``.
+        ``regularise`` adds a tiny stiffness-weighted shift, ``1e-12`` of the largest
+        diagonal entry of ``J^T J``."""
+        K, diag = self.rc.normal_matrix(J, upper=upper)
         if regularise:
             w = self.weights
             scale = float(K.data[diag].max(initial=1.0)) / float(w.max(initial=1.0))
             shift = shift + 1e-12 * scale * w
-        if self._mask_of[0] is not K.indptr or self._mask_of[1] is not self.free:
+        indptr, free, drop = self._drops.get(upper, (None, None, None))
+        if indptr is not K.indptr or free is not self.free or drop is None:
             rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
-            self._keep = self.free[rows] & self.free[K.indices]
-            self._mask_of = (K.indptr, self.free)
-        K.data *= self._keep
+            drop = np.flatnonzero(~(self.free[rows] & self.free[K.indices]))
+            self._drops[upper] = (K.indptr, self.free, drop)
+        K.data[drop] = 0.0
         K.data[diag] += np.where(self.free, shift, 1.0)
         return K
 
@@ -213,12 +226,23 @@ class RigidSolver:
         # where the actuators leave free motions a tiny stiffness-weighted regularisation
         # keeps the normal matrix regular (the right-hand side J^T r has no component along
         # them, so the step stays the minimum-norm Gauss-Newton step)
-        K = self._held_normal(J, regularise=self.underactuated is not False)
+        regularise = self.underactuated is not False
+        backend = self._backend
         try:
             # symmetric positive (semi)definite; the solver's fastest backend (PARDISO where
             # installed, else SuperLU with symmetric settings), ordering reused across steps.
             # A (nearly) singular matrix ends in SuperLU's exact LU, which names it.
-            self._lu = self._backend.factorize(K)
+            if isinstance(backend, PardisoBackend):
+                # PARDISO reads the upper triangle: build only that
+                U = self._held_normal(J, regularise=regularise, upper=True)
+                lu = backend.factorize(U, upper=True)
+                perturbed = getattr(lu, "perturbed_pivots", None)  # a PARDISO factor
+                if perturbed is not None and perturbed() > 0:  # singular to working precision
+                    K = self._held_normal(J, regularise=regularise)
+                    lu = get_backend("superlu").factorize(K)
+                self._lu = lu
+            else:
+                self._lu = backend.factorize(self._held_normal(J, regularise=regularise))
         except SingularMatrixError as exc:  # exactly singular: free creases not determined
             raise _Singular(str(exc)) from None
 
@@ -315,10 +339,13 @@ class RigidSolver:
             # from |r| ~ 1e-11, needs 1e-3, not 1e-10: one CG iteration instead of four)
             eta = float(np.clip(max(10.0 * res, 0.1 * tol / res), 1e-10, 1e-2))
             if it == 0:
-                # near the flat state the small singular values of J move fast: a reused
-                # factorisation from the previous step is a poor preconditioner
+                # a factorisation from the previous step is a poor preconditioner (70 x 70
+                # Miura, 4 deg steps: 11 CG iterations to 1e-3, 40 to 1e-6): factorise
                 self._factor(J)
-            step = self._solve_current(J, -(J.T @ r), eta)
+            if it == 0 and self.underactuated is False:
+                step = self._solve(-(J.T @ r))  # the factor of this very matrix
+            else:
+                step = self._solve_current(J, -(J.T @ r), eta)
             if not np.all(np.isfinite(step)):
                 return rho, hist, False
             smax = np.max(np.abs(step), initial=0.0)
@@ -686,6 +713,19 @@ def _least_energy_branch(solver: RigidSolver, first: np.ndarray) -> np.ndarray:
         if ok and (k[0] < k_best[0] or (k[0] == k_best[0] and k[1] < k_best[1] * (1 - 1e-9))):
             best, k_best = cand, k
     return best
+
+
+def _normal_backend(n_var: int) -> LinearBackend:
+    """The corrector's backend: PARDISO set for normal equations from ``PARDISO_MIN_VARS``
+    crease variables on (where it imports), else the fastest other backend; SuperLU below."""
+    if n_var < PARDISO_MIN_VARS:
+        return get_backend("superlu")
+    if "pardiso" in available_backends():
+        try:
+            return PardisoBackend(normal_equations=True)
+        except Exception as exc:  # a broken optional install must not stop a fold
+            log.debug("PARDISO unavailable: %s", exc)
+    return get_backend("auto")
 
 
 def _normal_diagonal(J: sp.csr_matrix) -> np.ndarray:

@@ -168,3 +168,13 @@ def test_normal_matrix_equals_the_jacobian_product(make):
     Ko, diag_o = rc.normal_matrix(other)
     np.testing.assert_allclose(Ko.toarray(), (other.T @ other).toarray(), rtol=0, atol=1e-13)
     np.testing.assert_allclose(Ko.data[diag_o], (other.T @ other).diagonal(), rtol=0, atol=1e-13)
+    # the upper triangle alone (what PARDISO reads), on the fixed pattern and the fallback
+    for M, full in ((J, ref), (other, (other.T @ other).toarray())):
+        U, diag_u = rc.normal_matrix(M, upper=True)
+        np.testing.assert_allclose(
+            U.toarray(), np.triu(full), rtol=0, atol=1e-13 * np.abs(full).max()
+        )
+        rows_u = np.repeat(np.arange(rc.n_var), np.diff(U.indptr))
+        np.testing.assert_array_equal(U.indices[diag_u], np.arange(rc.n_var))
+        np.testing.assert_array_equal(rows_u[diag_u], np.arange(rc.n_var))
+        assert np.all(np.diff(U.indices)[np.diff(rows_u) == 0] > 0)  # sorted within rows

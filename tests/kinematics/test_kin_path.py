@@ -252,3 +252,34 @@ def test_rigid_steps_take_one_corrector_iteration_once_the_predictor_has_states(
     assert later.sum() <= len(later) + 3
     assert max(float(np.max(h)) for h in path.residual_norms[1:] if len(h)) < 1e-3
     assert path.meta["max_closure"] <= 1e-13
+
+
+@pytest.mark.skipif("pardiso" not in available_backends(), reason="pypardiso not installed")
+def test_a_normal_matrix_singular_to_working_precision_goes_to_the_exact_lu(monkeypatch):
+    """The corrector factorises the upper triangle with PARDISO; where PARDISO has to perturb
+    pivots (here: no actuator held on a 1-DOF folded Miura sheet, so J^T J has a null
+    vector), the factor is SuperLU's exact LU of the full matrix, never PARDISO's
+    approximate solve."""
+    from barhinge.kinematics import path as rigid_path
+    from barhinge.kinematics.constraints import RigidConstraints
+    from barhinge.linalg.backends import PardisoBackend
+
+    monkeypatch.setattr(rigid_path, "PARDISO_MIN_VARS", 0)
+    rc = RigidConstraints.from_pattern(bh.families.miura(4, 4, fold=20.0))
+    solver = rigid_path.RigidSolver(rc, np.zeros(0, np.int64), rigid_path.RigidOptions())
+    assert isinstance(solver._backend, PardisoBackend)
+    solver.underactuated = False  # no regularisation: the matrix stays singular
+    _, J = rc.evaluate(rc.rho0)
+    solver._factor(J)
+    assert type(solver._lu).__name__ == "_SuperLUFactor"
+    # held by one actuator the matrix is regular: PARDISO's own factor, solving J^T J
+    act = rc.var_of_source_edge[[int(bh.families.miura_layout(4, 4).interior_zigzag_edges[0])]]
+    held = rigid_path.RigidSolver(rc, act, rigid_path.RigidOptions())
+    held.underactuated = False
+    held._factor(J)
+    assert type(held._lu).__name__ == "_PardisoFactor"
+    b = np.where(held.free, np.random.default_rng(0).random(rc.n_var), 0.0)
+    x = held._solve(b)
+    free = held.free
+    K = (J.T @ J).toarray()[np.ix_(free, free)]
+    np.testing.assert_allclose(K @ x[free], b[free], rtol=0, atol=1e-9 * np.abs(b).max())

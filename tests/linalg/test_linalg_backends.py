@@ -193,3 +193,24 @@ def test_pardiso_frees_its_factor_with_the_backend():
 def test_a_pardiso_backend_that_never_factorised_is_dropped_quietly():
     b = get_backend("pardiso")
     del b
+
+
+@needs_pardiso
+def test_pardiso_normal_equations_profile_solves_like_a_dense_solve():
+    """The profile for normal equations (no matching or scaling, two-level factorisation)
+    solves ``J^T J x = b`` from its upper triangle like numpy's dense solve, refactorises
+    the same pattern with new values, and is not offered bordered (saddle-point) matrices."""
+    from barhinge.linalg.backends import PardisoBackend
+
+    rng = np.random.default_rng(3)
+    backend = PardisoBackend(normal_equations=True)
+    assert backend.saddle_point is False and PardisoBackend.saddle_point is True
+    J = sp.random(90, 60, density=0.08, random_state=rng) + sp.eye(90, 60)
+    b = rng.random(60)
+    for scale in (1.0, 2.5):
+        K = sp.csr_matrix((scale * J).T @ (scale * J))
+        K.setdiag(K.diagonal())
+        U = sp.triu(K, format="csr")
+        U.sort_indices()
+        f = backend.factorize(U, upper=True)
+        np.testing.assert_allclose(f.solve(b), np.linalg.solve(K.toarray(), b), rtol=1e-9)
