@@ -400,7 +400,16 @@ def load_scene(path: str | Path) -> Scene:
     path = Path(path)
     try:
         with path.open("rb") as fh:
-            data = tomllib.load(fh)
+            raw = fh.read()
+        pattern_kind = _crease_pattern_kind(path, raw)
+        if pattern_kind:
+            raise ConfigError(
+                f"{path.name} is {pattern_kind}, not a scene TOML: to fold a crease pattern, a "
+                f'scene reads it with [pattern] file = "{path.name}" and names what drives the '
+                f"fold (actuators, supports, loads); `barhinge dof {path.name}` suggests "
+                f"actuators, data/scenes/*.toml are examples, docs/solver.md lists every key"
+            )
+        data = tomllib.loads(raw.decode("utf-8"))
     except FileNotFoundError:
         raise ConfigError(f"scene file {str(path)!r} does not exist") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
@@ -409,6 +418,22 @@ def load_scene(path: str | Path) -> Scene:
         raise ConfigError(f"scene file {str(path)!r} cannot be read: {exc.strerror}") from None
     data.setdefault("name", path.stem)
     return scene_from_dict(data, base_dir=path.parent)
+
+
+def _crease_pattern_kind(path: Path, raw: bytes) -> str:
+    """What the file given as a scene is when it is a crease pattern's format rather than
+    TOML (by its suffix, or by content: a JSON object or an XML document, which no scene
+    TOML starts with): ``"a FOLD file"``, ``"a JSON file"``, ``"an SVG file"``; ``""``
+    otherwise."""
+    suffix = path.suffix.lower()
+    head = raw.lstrip()[:1]
+    if suffix == ".svg" or (head == b"<" and suffix != ".toml"):
+        return "an SVG file"
+    if suffix == ".fold":
+        return "a FOLD file"
+    if suffix == ".json" or (head == b"{" and suffix != ".toml"):
+        return "a JSON file"
+    return ""
 
 
 def _check_keys(d: Any, allowed: set[str], where: str) -> None:

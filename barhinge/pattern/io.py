@@ -34,6 +34,12 @@ def read(path: str | Path, **kwargs: Any) -> CreasePattern:
     try:
         module, name = READERS[path.suffix.lower()]
     except KeyError:
+        if path.suffix.lower() == ".toml":
+            raise PatternError(
+                f"{path.name} is a scene TOML, not a crease pattern: crease patterns are read "
+                f"from {' or '.join(READERS)} files (the scene's [pattern] table names its file "
+                f"or family)"
+            ) from None
         raise PatternError(
             f"{path.name}: unknown crease-pattern file type {path.suffix!r}; expected "
             f"{' or '.join(READERS)}"

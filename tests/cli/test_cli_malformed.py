@@ -671,6 +671,17 @@ def _rows() -> list[Row]:
             )
     add(Row("info-dir", "info {d}/a_dir.fold", "a_dir.fold: is a folder"))
     add(Row("dof-dir", "dof {d}/a_dir.fold", "a_dir.fold: is a folder"))
+    # --- a crease pattern given as a scene, a scene given as a crease pattern: the error
+    # says which is which and how a scene reads a pattern
+    add(Row("fold-a-fold-file", "fold {d}/valid.fold --out {o}", 'file = "valid.fold"'))
+    add(
+        Row(
+            "fold-an-svg-file",
+            f"fold {REPO}/tests/data/crease-patterns/origami-simulator/miura-ori.svg --out {{o}}",
+            "miura-ori.svg is an SVG file, not a scene TOML",
+        )
+    )
+    add(Row("dof-a-scene", "dof {d}/s/ok.toml", "ok.toml is a scene TOML, not a crease pattern"))
     # --- scenes
     # (--out under a file: a scene accepted by mistake fails fast, before writing results)
     for name in SCENES:
