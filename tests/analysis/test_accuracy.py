@@ -356,3 +356,50 @@ def test_a_refinement_out_of_its_asymptotic_range_is_refused_with_its_changes(mo
     assert "no model up to m = 16 meets the accuracy 10 %: the refinement is not in its " in msg
     assert "stiffness changes from m = 2 to 16: +22.2 %, -18.2 %, +22.2 %" in msg  # 90, 110, ...
     assert "(rigid)" not in msg
+
+
+def test_richardson_caps_the_order_it_extrapolates_with():
+    """An observed order above ``max_order`` extrapolates with ``max_order``: on
+    ``3 + 2 m^-2`` the changes from m = 4, 8, 16 are -0.09375 and -0.0234375 (order 2); capped
+    at 1 the correction is the last change itself, and the observed order is still returned."""
+    vals = [3 + 2 * m**-2.0 for m in (4, 8, 16)]
+    ref, p, corr = richardson(vals, max_order=1.0)
+    assert p == pytest.approx(2.0, rel=1e-12)
+    assert corr == pytest.approx(abs(vals[-1] - vals[-2]), rel=1e-12)
+    assert ref == pytest.approx(vals[-1] + (vals[-1] - vals[-2]), rel=1e-12)
+    assert richardson(vals, max_order=3.0) == richardson(vals)  # below the cap: unchanged
+
+
+def test_a_late_slow_error_of_opposite_sign_does_not_pass_for_converged(monkeypatch):
+    """``k(m) = 100 + 20/m - 200/m^2`` (limit 100): the fast m^-2 part dominates m = 2 ... 16
+    (changes +32.5, +6.9, +1.1: observed orders 2.24 and 2.65, within Roache's factor 2), the
+    slow m^-1 part of the other sign turns the sequence back from m = 32 on, as the refined
+    miura_arc 120 roof does. Extrapolated with the observed order, m = 16 would be estimated
+    at 0.41 % and chosen for 0.45 % while its true error is 0.47 %; with the order capped at
+    ``ESTIMATE_MAX_ORDER`` no candidate's estimate is below its true error, and the target
+    is refused instead."""
+    import barhinge.analysis.accuracy as acc
+
+    def k(m: int) -> float:
+        return 100.0 + 20.0 / m - 200.0 / m**2
+
+    monkeypatch.setattr(acc, "subdivided_scene", lambda static, m, scheme="N5B8": (m, scheme))
+    monkeypatch.setattr(
+        acc, "_response", lambda sc: ({"stiffness": k(sc[0]), "displacement": 1.0}, sc[0])
+    )
+    # the uncapped extrapolation of m = 2 ... 16 underestimates the error of m = 16
+    vals = [k(m) for m in (2, 4, 8, 16)]
+    ref, _, corr = richardson(vals)
+    assert acc.in_asymptotic_range(vals)
+    assert abs(vals[-1] / ref - 1) + corr / ref < abs(vals[-1] / 100.0 - 1)
+    # the chooser's estimates bound every candidate's true error
+    ch = choose_model(_roof(), "5%", max_m=64, max_dofs=10**9)
+    assert ch.chosen.m == 8  # estimated 3.2 %, true 0.6 %
+    for c in ch.candidates:
+        if c.m >= 2 and math.isfinite(c.error):
+            assert abs(c.values["stiffness"] / 100.0 - 1.0) <= c.error, c.name
+    with pytest.raises(bh.errors.ConvergenceError, match="no model up to m = 16"):
+        choose_model(_roof(), "0.45%", max_m=16, max_dofs=10**9)
+    # past m = 16 the sequence turns back: not in its asymptotic range, nothing passes 2 %
+    with pytest.raises(bh.errors.ConvergenceError, match="not in its asymptotic range"):
+        choose_model(_roof(), "2%", max_m=64, max_dofs=10**9)
