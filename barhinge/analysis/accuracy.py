@@ -463,6 +463,7 @@ def choose_model(
     if not ok:
         best = min(cands, key=lambda c: c.error)
         head = f"no model up to m = {levels[-1]} meets the accuracy {100 * acc:g} %"
+        hint = _next_level_hint(scene.model.pattern, levels[-1], max_m, max_dofs)
         if not any(math.isfinite(c.error) for c in cands if c.m > 1):
             q = "stiffness" if "stiffness" in outs else "displacement"
             vals = [v[q] for v in seq]
@@ -472,12 +473,24 @@ def choose_model(
             raise ConvergenceError(
                 f"{head}: the refinement is not in its asymptotic range, so no refined level's "
                 f"error can be estimated ({q} changes from m = {levels[0]} to "
-                f"{levels[len(seq) - 1]}: {steps})"
+                f"{levels[len(seq) - 1]}: {steps}){hint}"
             )
         raise ConvergenceError(
-            f"{head}: the best estimate is {100 * best.error:.2g} % ({best.name})"
+            f"{head}: the best estimate is {100 * best.error:.2g} % ({best.name}){hint}"
         )
     return ModelChoice(ok[0], tuple(cands), acc, outs, ref, rate, REFINED_MODEL)
+
+
+def _next_level_hint(cp, m_last: int, max_m: int, max_dofs: int) -> str:
+    """What stopped the refinement at ``m_last``, for a refusal: the next level's size
+    against ``max_dofs`` (the CLI's ``--accuracy-max-dofs``), or ``max_m``."""
+    nxt = 2 * m_last
+    if nxt > max_m or nxt > LEVELS[-1]:
+        return f"; m = {m_last} is the finest level tried (max_m = {max_m})"
+    return (
+        f"; the next level, m = {nxt}, would have {_level_dofs(cp, nxt):,} DOFs, more than "
+        f"max_dofs = {max_dofs:,} (CLI: --accuracy-max-dofs)"
+    )
 
 
 def _level_dofs(cp, m: int) -> int:

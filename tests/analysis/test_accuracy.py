@@ -403,3 +403,27 @@ def test_a_late_slow_error_of_opposite_sign_does_not_pass_for_converged(monkeypa
     # past m = 16 the sequence turns back: not in its asymptotic range, nothing passes 2 %
     with pytest.raises(bh.errors.ConvergenceError, match="not in its asymptotic range"):
         choose_model(_roof(), "2%", max_m=64, max_dofs=10**9)
+
+
+def test_a_refusal_names_what_stopped_the_refinement(monkeypatch):
+    """A refused target says what a finer level would cost: the next level's DOFs against
+    the budget (and the CLI option that raises it), or that ``max_m`` was the finest."""
+    import barhinge.analysis.accuracy as acc
+
+    def fake_response(sc):
+        m, _ = sc
+        return {"stiffness": 100.0 * (1.0 + 1.0 / m), "displacement": 1.0 + 1.0 / m}, m
+
+    monkeypatch.setattr(acc, "subdivided_scene", lambda static, m, scheme="N5B8": (m, scheme))
+    monkeypatch.setattr(acc, "_response", fake_response)
+    scene = _roof()
+    budget = acc._level_dofs(scene.model.pattern, 16)
+    with pytest.raises(bh.errors.ConvergenceError) as exc:
+        choose_model(scene, "2%", max_dofs=budget)
+    nxt = acc._level_dofs(scene.model.pattern, 32)
+    assert str(exc.value).endswith(
+        f"the next level, m = 32, would have {nxt:,} DOFs, more than max_dofs = {budget:,} "
+        "(CLI: --accuracy-max-dofs)"
+    )
+    with pytest.raises(bh.errors.ConvergenceError, match=r"m = 16 is the finest level tried"):
+        choose_model(scene, "2%", max_m=16, max_dofs=10**9)
