@@ -107,15 +107,20 @@ def _stiffness(model, S) -> float:
     return float(F[:, 2].sum() ** 2 / np.sum(F * U))
 
 
+def _navier_error(mat, m: int, grading: float = 1.0) -> float:
+    """|stiffness / Navier's - 1| of the simply supported unit square cut into m x m coupled
+    cells (``grading``: :func:`barhinge.pattern.subdivide.subdivided`)."""
+    cpm, parent = subdivided(SQUARE, m, grading)
+    model = coupled_bending(bh.BarHingeModel.from_pattern(cpm, "N5B8", mat))
+    S = np.zeros((model.n_nodes, 3), bool)
+    S[np.union1d(np.arange(4), np.flatnonzero(parent >= 0))] = True
+    return abs(_stiffness(model, S) / _navier(mat.bending_rigidity) - 1.0)
+
+
 def test_simply_supported_plate_converges_to_navier_at_order_two():
     mat = bh.Material(E=70e9, nu=0.33, t=2e-3)
-    levels, err = [4, 8, 16], []
-    for m in levels:
-        cpm, parent = subdivided(SQUARE, m)
-        model = coupled_bending(bh.BarHingeModel.from_pattern(cpm, "N5B8", mat))
-        S = np.zeros((model.n_nodes, 3), bool)
-        S[np.union1d(np.arange(4), np.flatnonzero(parent >= 0))] = True
-        err.append(abs(_stiffness(model, S) / _navier(mat.bending_rigidity) - 1.0))
+    levels = [4, 8, 16]
+    err = [_navier_error(mat, m) for m in levels]
     rate = -np.polyfit(np.log(levels), np.log(err), 1)[0]
     assert rate == pytest.approx(2.0, abs=0.3)
     assert err[-1] < 2e-3
@@ -130,14 +135,7 @@ def test_graded_cells_converge_to_navier_at_order_two_with_a_larger_constant():
     bending."""
     mat = bh.Material(E=70e9, nu=0.33, t=2e-3)
     levels = [8, 16, 32]
-    err: dict[float, list[float]] = {1.0: [], 2.0: []}
-    for grading in err:
-        for m in levels:
-            cpm, parent = subdivided(SQUARE, m, grading)
-            model = coupled_bending(bh.BarHingeModel.from_pattern(cpm, "N5B8", mat))
-            S = np.zeros((model.n_nodes, 3), bool)
-            S[np.union1d(np.arange(4), np.flatnonzero(parent >= 0))] = True
-            err[grading].append(abs(_stiffness(model, S) / _navier(mat.bending_rigidity) - 1.0))
+    err = {g: [_navier_error(mat, m, g) for m in levels] for g in (1.0, 2.0)}
     rate = -np.polyfit(np.log(levels), np.log(err[2.0]), 1)[0]
     assert rate == pytest.approx(2.0, abs=0.2)
     assert err[2.0][-1] < 1e-2
