@@ -66,6 +66,30 @@ __all__ = [
 
 
 # --------------------------------------------------------------------------- helpers
+def cos_sin(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``cos(phi)`` and ``sin(phi)`` from the half-angle tangent ``t = tan(phi / 2)``:
+    ``((1 - t^2) / (1 + t^2), 2 t / (1 + t^2))``, within a few units in the last place of
+    1 (absolute) for every angle (radians). NumPy evaluates ``tan`` vectorised where it evaluates
+    ``cos`` and ``sin`` one value at a time (six times slower on a 70 x 70 Miura's 38 920
+    creases)."""
+    t = np.tan(0.5 * np.asarray(phi, dtype=float))
+    d = 1.0 / (1.0 + t * t)
+    return (1.0 - t * t) * d, 2.0 * t * d
+
+
+def _turn(
+    a: np.ndarray, b: np.ndarray, c: np.ndarray, s: np.ndarray, t: np.ndarray, u: np.ndarray
+) -> None:
+    """``a, b = a c + b s, b c - a s`` in place (rows of whole vertex arrays; ``t``, ``u``
+    scratch of the same shape)."""
+    np.multiply(a, s, out=t)
+    a *= c
+    np.multiply(b, s, out=u)
+    a += u
+    b *= c
+    b -= t
+
+
 def rodrigues(u: np.ndarray, phi: np.ndarray) -> np.ndarray:
     """(..., k, 3, 3) rotations about unit axes ``u`` (k, 3) by angles ``phi`` (..., k)
     radians (a leading batch of angle sets shares the axes)."""
@@ -429,23 +453,26 @@ class RigidConstraints:
 
     def _loop_products_t(self, rho: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`loop_products` with the vertex index last: F (3, 3, n_cv), A (D, 3, n_cv)
-        (contiguous rows of length n_cv: the products run on whole rows)."""
+        (contiguous rows of length n_cv: the products run on whole rows, in place)."""
         lv, valid, ca, sa = self._loop_t
         D, nv = lv.shape
         # cos and sin once per crease (each sits in two loops), gathered into the slots;
         # an empty slot turns by 0
+        c, s = cos_sin(rho)
         at = np.maximum(lv, 0)
-        cr = np.where(valid, np.cos(rho)[at], 1.0)
-        sr = np.where(valid, np.sin(rho)[at], 0.0)
+        cr = np.where(valid, c[at], 1.0)
+        sr = np.where(valid, s[at], 0.0)
         # columns of the running product F, updated by F <- F Rx(rho_j) Rz(alpha_j)
-        c0, c1, c2 = np.zeros((3, nv)), np.zeros((3, nv)), np.zeros((3, nv))
-        c0[0] = c1[1] = c2[2] = 1.0
+        F = np.zeros((3, 3, nv))  # F[k] is column k
+        F[0, 0] = F[1, 1] = F[2, 2] = 1.0
+        c0, c1, c2 = F
         A = np.empty((D, 3, nv))
+        t, u = np.empty((3, nv)), np.empty((3, nv))
         for j in range(D):
             A[j] = c0
-            c1, c2 = c1 * cr[j] + c2 * sr[j], c2 * cr[j] - c1 * sr[j]
-            c0, c1 = c0 * ca[j] + c1 * sa[j], c1 * ca[j] - c0 * sa[j]
-        return np.stack([c0, c1, c2], axis=1), A
+            _turn(c1, c2, cr[j], sr[j], t, u)  # c1, c2 = c1 cr + c2 sr, c2 cr - c1 sr
+            _turn(c0, c1, ca[j], sa[j], t, u)  # c0, c1 = c0 ca + c1 sa, c1 ca - c0 sa
+        return F.transpose(1, 0, 2), A
 
     def residual(self, rho: np.ndarray) -> np.ndarray:
         """(3 n_cv,) closure residual ``vee(skew(F))`` per vertex (zero when closed)."""

@@ -49,6 +49,7 @@ from barhinge.kinematics.constraints import RigidConstraints
 from barhinge.kinematics.dof import FLAT_TOL, _branch_direction
 from barhinge.linalg.backends import (
     Factor,
+    IndefiniteMatrixError,
     LinearBackend,
     PardisoBackend,
     SingularMatrixError,
@@ -192,6 +193,8 @@ class RigidSolver:
         # SuperLU spares a small fold the loading of MKL
         self._backend = _normal_backend(rc.n_var)
         self.iterations = 0
+        #: corrector attempts stopped by a singular Jacobian at a bifurcation point
+        self.singular_attempts = 0
         self.last_guess: np.ndarray | None = None
 
     # ---------------------------------------------------------------- linear algebra
@@ -233,14 +236,14 @@ class RigidSolver:
             # installed, else SuperLU with symmetric settings), ordering reused across steps.
             # A (nearly) singular matrix ends in SuperLU's exact LU, which names it.
             if isinstance(backend, PardisoBackend):
-                # PARDISO reads the upper triangle: build only that
+                # PARDISO's Cholesky reads the upper triangle: build only that. A pivot that
+                # is not positive means singular to working precision: SuperLU's exact LU
                 U = self._held_normal(J, regularise=regularise, upper=True)
-                lu = backend.factorize(U, upper=True)
-                perturbed = getattr(lu, "perturbed_pivots", None)  # a PARDISO factor
-                if perturbed is not None and perturbed() > 0:  # singular to working precision
+                try:
+                    self._lu = backend.factorize(U, upper=True)
+                except IndefiniteMatrixError:
                     K = self._held_normal(J, regularise=regularise)
-                    lu = get_backend("superlu").factorize(K)
-                self._lu = lu
+                    self._lu = get_backend("superlu").factorize(K)
             else:
                 self._lu = backend.factorize(self._held_normal(J, regularise=regularise))
         except SingularMatrixError as exc:  # exactly singular: free creases not determined
@@ -338,14 +341,23 @@ class RigidSolver:
             # asks no more of the new residual than ``tol`` (the last iteration of a step,
             # from |r| ~ 1e-11, needs 1e-3, not 1e-10: one CG iteration instead of four)
             eta = float(np.clip(max(10.0 * res, 0.1 * tol / res), 1e-10, 1e-2))
-            if it == 0:
-                # a factorisation from the previous step is a poor preconditioner (70 x 70
-                # Miura, 4 deg steps: 11 CG iterations to 1e-3, 40 to 1e-6): factorise
-                self._factor(J)
-            if it == 0 and self.underactuated is False:
-                step = self._solve(-(J.T @ r))  # the factor of this very matrix
-            else:
-                step = self._solve_current(J, -(J.T @ r), eta)
+            try:
+                if it == 0:
+                    # a factorisation from the previous step is a poor preconditioner (70 x
+                    # 70 Miura, 4 deg steps: 11 CG iterations to 1e-3, 40 to 1e-6): factorise
+                    self._factor(J)
+                if it == 0 and self.underactuated is False:
+                    step = self._solve(-(J.T @ r))  # the factor of this very matrix
+                else:
+                    step = self._solve_current(J, -(J.T @ r), eta)
+            except _Singular:
+                if self.underactuated is not False:
+                    raise  # free motions the actuators leave, or not known yet
+                # the actuators determine the motion, so the Jacobian is singular only at a
+                # bifurcation point (a degree-4 vertex's flat state); the prediction or an
+                # iterate met one: the step is cut back as if it had diverged
+                self.singular_attempts += 1
+                return rho, hist, False
             if not np.all(np.isfinite(step)):
                 return rho, hist, False
             smax = np.max(np.abs(step), initial=0.0)
@@ -472,7 +484,7 @@ class RigidSolver:
             g = J.T @ r + sgn * viol
             try:
                 step = self._backend.factorize(Kf).solve(np.where(self.free, -g, 0.0))
-            except SingularMatrixError:  # damping lost below round-off: damp more
+            except (SingularMatrixError, IndefiniteMatrixError):  # damping below round-off
                 mu *= 10.0
                 if mu > 1e12:
                     break
@@ -716,13 +728,15 @@ def _least_energy_branch(solver: RigidSolver, first: np.ndarray) -> np.ndarray:
 
 
 def _normal_backend(n_var: int) -> LinearBackend:
-    """The corrector's backend: PARDISO set for normal equations from ``PARDISO_MIN_VARS``
-    crease variables on (where it imports), else the fastest other backend; SuperLU below."""
+    """The corrector's backend: PARDISO's Cholesky from ``PARDISO_MIN_VARS`` crease
+    variables on (where it imports; the normal matrices are positive definite off the
+    bifurcation points, and :class:`IndefiniteMatrixError` names one that is not), else the
+    fastest other backend; SuperLU below."""
     if n_var < PARDISO_MIN_VARS:
         return get_backend("superlu")
     if "pardiso" in available_backends():
         try:
-            return PardisoBackend(normal_equations=True)
+            return PardisoBackend(definite=True)
         except Exception as exc:  # a broken optional install must not stop a fold
             log.debug("PARDISO unavailable: %s", exc)
     return get_backend("auto")
@@ -883,6 +897,7 @@ def rigid_fold(
             and not (np.max(np.abs(rho), initial=0.0) < FLAT_TOL)
         )
         least_squares = opt.over_actuated == "least_squares" and len(av) >= 2
+        singular_before = solver.singular_attempts
         while True:
             try:
                 ok, rho_new, over = _advance(
@@ -962,6 +977,12 @@ def rigid_fold(
                     f"step {s}: the fold-spring energy over the free motions the actuators "
                     f"leave did not reach a minimum in {opt.energy_max_iter} Newton iterations "
                     f"after {opt.max_cutbacks} cut-backs; drive more creases"
+                )
+            elif solver.singular_attempts > singular_before:
+                msg = (
+                    f"step {s}: the Jacobian of the free creases is singular near the path "
+                    f"after {opt.max_cutbacks} cut-backs (a bifurcation point the actuators "
+                    f"cannot pass; drive other creases)"
                 )
             else:
                 flat = np.max(np.abs(rho), initial=0.0) < FLAT_TOL

@@ -24,6 +24,7 @@ to).
 
 from __future__ import annotations
 
+import ctypes
 import glob
 import importlib.util
 import logging
@@ -215,10 +216,46 @@ class _PardisoFactor:
     def solve(self, b: np.ndarray) -> np.ndarray:
         if self._generation != self._backend._generation:
             raise RuntimeError("this PARDISO factor was replaced by a newer factorisation")
-        s = self._backend._solver
-        b = np.asfortranarray(b, dtype=float)
-        s.set_phase(33)  # solve with the stored factor (skips pypardiso's matrix comparison)
-        return s._call_pardiso(self._A, b)
+        # solve with the stored factor (skips pypardiso's matrix comparison)
+        return _call_pardiso(self._backend._solver, 33, self._A, b)
+
+
+def _call_pardiso(solver, phase: int, A: sp.csr_matrix, b: np.ndarray) -> np.ndarray:
+    """One call of MKL's ``pardiso`` through pypardiso's solver handle ``solver`` (its
+    ``pt``, ``iparm``, ``perm``), with ``A``'s own zero-based CSR index arrays
+    (``iparm(35) = 1``): pypardiso's ``_call_pardiso`` makes one-based int32 copies of both on
+    every call (52 ms and 480 MB at the 60 M entries of a 200 x 200 Miura's bordered matrix).
+    Returns the solution for the solve phases (C order); raises pypardiso's error."""
+    from pypardiso.pardiso_wrapper import PyPardisoError
+
+    ia = A.indptr if A.indptr.dtype == np.int32 else A.indptr.astype(np.int32)
+    ja = A.indices if A.indices.dtype == np.int32 else A.indices.astype(np.int32)
+    data = np.ascontiguousarray(A.data, dtype=float)
+    b = np.asfortranarray(b, dtype=float)
+    x = np.zeros_like(b)
+    err = ctypes.c_int32(0)
+    i32, f64 = ctypes.POINTER(ctypes.c_int32), ctypes.POINTER(ctypes.c_double)
+    solver._mkl_pardiso(
+        solver.pt.ctypes.data_as(ctypes.POINTER(solver._pt_type[0])),
+        ctypes.byref(ctypes.c_int32(1)),  # maxfct
+        ctypes.byref(ctypes.c_int32(1)),  # mnum
+        ctypes.byref(ctypes.c_int32(solver.mtype)),
+        ctypes.byref(ctypes.c_int32(phase)),
+        ctypes.byref(ctypes.c_int32(A.shape[0])),
+        data.ctypes.data_as(f64),
+        ia.ctypes.data_as(i32),
+        ja.ctypes.data_as(i32),
+        solver.perm.ctypes.data_as(i32),
+        ctypes.byref(ctypes.c_int32(1 if b.ndim == 1 else b.shape[1])),  # nrhs
+        solver.iparm.ctypes.data_as(i32),
+        ctypes.byref(ctypes.c_int32(solver.msglvl)),
+        b.ctypes.data_as(f64),
+        x.ctypes.data_as(f64),
+        ctypes.byref(err),
+    )
+    if err.value != 0:
+        raise PyPardisoError(err.value)
+    return np.ascontiguousarray(x)
 
 
 def _point_pypardiso_at_mkl() -> None:
@@ -248,28 +285,22 @@ class PardisoBackend:
     #: iterative refinement only after perturbed pivots (two steps always cost 2.5x the
     #: solve and gained a factor 2 in residual, 2e-8 -> 1e-8 on a 38 963-row Miura KKT),
     #: pivot threshold 1e-8, symmetric scaling, weighted matching, 1x1 and 2x2
-    #: Bunch-Kaufman pivots
-    IPARM = {1: 1, 2: 2, 8: 0, 10: 8, 11: 1, 13: 1, 21: 1}
+    #: Bunch-Kaufman pivots; zero-based indices (iparm(35) = 1, :func:`_call_pardiso`)
+    IPARM = {1: 1, 2: 2, 8: 0, 10: 8, 11: 1, 13: 1, 21: 1, 35: 1}
 
     #: iparm of the definite mode (``mtype = 2``, Cholesky): no pivoting, so no matching,
-    #: scaling or Bunch-Kaufman settings
-    IPARM_DEFINITE = {1: 1, 2: 2, 8: 0}
+    #: scaling or Bunch-Kaufman settings; MKL's two-level factorisation (iparm(24) = 1), 2
+    #: MKL threads: on a Miura tangent of 118 437 free DOFs a factorisation takes 0.33 s
+    #: against 0.36 s and a solve 21 ms against 48 ms; on the rigid corrector's normal
+    #: matrix of a 70 x 70 Miura sheet 9.0 ms against 16.6 ms and 0.9 ms against 7.0 ms
+    IPARM_DEFINITE = {1: 1, 2: 2, 8: 0, 24: 1, 35: 1}
 
-    #: iparm of the indefinite mode for matrices without a saddle-point structure (normal
-    #: equations ``J^T J``, positive semidefinite): no weighted matching or scaling, and
-    #: MKL's two-level factorisation (iparm(24) = 1). On the rigid corrector's normal matrix
-    #: of a 70 x 70 Miura sheet (38 920 rows) a numeric factorisation takes 10.3 ms against
-    #: 12.4 ms and a solve 1.7 ms against 4.3 ms with :attr:`IPARM`
-    IPARM_NORMAL = {1: 1, 2: 2, 8: 0, 10: 8, 21: 1, 24: 1}
-
-    def __init__(self, definite: bool = False, *, normal_equations: bool = False) -> None:
+    def __init__(self, definite: bool = False) -> None:
         """``definite``: Cholesky (``mtype = 2``) for matrices expected to be positive
         definite; a matrix that is not raises :class:`IndefiniteMatrixError` (the analysis
         is kept for the next matrix of the pattern). About 1.5x faster than the indefinite
-        mode on a Miura tangent (0.081 s against 0.120 s at 38 877 DOF).
-        ``normal_equations``: the matrices are normal equations (no saddle-point structure),
-        so the indefinite mode skips matching and scaling (:attr:`IPARM_NORMAL`); such a
-        backend is not offered bordered matrices."""
+        mode on a Miura tangent (0.081 s against 0.120 s at 38 877 DOF). Such a backend is
+        not offered bordered (saddle-point) matrices."""
         _point_pypardiso_at_mkl()  # before the import: pypardiso makes a solver on import
         # reproducible results (MKL's conditional numerical reproducibility): without it MKL
         # picks code paths by memory alignment, and two identical runs of a sheet through a
@@ -280,12 +311,11 @@ class PardisoBackend:
         import pypardiso
 
         self.definite = definite
-        if normal_equations:
+        if definite:
             self.saddle_point = False
         self._solver = pypardiso.PyPardisoSolver(mtype=2 if definite else -2)
         self._solver.set_statistical_info_off()
-        iparm = self.IPARM_NORMAL if normal_equations else self.IPARM
-        for i, v in (self.IPARM_DEFINITE if definite else iparm).items():
+        for i, v in (self.IPARM_DEFINITE if definite else self.IPARM).items():
             self._solver.set_iparm(i, v)
         self._key: tuple | None = None
         self._upper_key: tuple | None = None
@@ -365,13 +395,12 @@ class PardisoBackend:
             if key != self._key:
                 # phase 12: analysis + numeric factorisation (called directly: pypardiso's
                 # ``factorize`` keeps a copy of the matrix, which the factor holds already)
-                s.set_phase(12)
-                s._call_pardiso(U, np.zeros((U.shape[0], 1)))
+                _call_pardiso(s, 12, U, np.zeros((U.shape[0], 1)))
                 s.factorized_A = U
                 self._key = key
             else:
-                s.set_phase(22)  # numeric factorisation with the stored analysis
-                s._call_pardiso(U, np.zeros((U.shape[0], 1)))
+                # numeric factorisation with the stored analysis
+                _call_pardiso(s, 22, U, np.zeros((U.shape[0], 1)))
                 s.factorized_A = U  # built here, never modified: no copy needed
         except Exception as exc:  # pypardiso.PyPardisoError: zero pivot, singular matrix
             if self.definite and getattr(exc, "value", None) == -4:

@@ -196,14 +196,16 @@ def test_a_pardiso_backend_that_never_factorised_is_dropped_quietly():
 
 
 @needs_pardiso
-def test_pardiso_normal_equations_profile_solves_like_a_dense_solve():
-    """The profile for normal equations (no matching or scaling, two-level factorisation)
-    solves ``J^T J x = b`` from its upper triangle like numpy's dense solve, refactorises
-    the same pattern with new values, and is not offered bordered (saddle-point) matrices."""
-    from barhinge.linalg.backends import PardisoBackend
+def test_pardiso_cholesky_solves_normal_equations_like_a_dense_solve():
+    """The definite mode (Cholesky, two-level factorisation), as the rigid corrector uses it,
+    solves ``J^T J x = b`` from its upper triangle like numpy's dense solve, refactorises the
+    same pattern with new values, is not offered bordered (saddle-point) matrices, and names
+    a singular normal matrix (a column of ``J`` zero: its pivot is exactly 0) as not
+    positive definite."""
+    from barhinge.linalg.backends import IndefiniteMatrixError, PardisoBackend
 
     rng = np.random.default_rng(3)
-    backend = PardisoBackend(normal_equations=True)
+    backend = PardisoBackend(definite=True)
     assert backend.saddle_point is False and PardisoBackend.saddle_point is True
     J = sp.random(90, 60, density=0.08, random_state=rng) + sp.eye(90, 60)
     b = rng.random(60)
@@ -214,3 +216,8 @@ def test_pardiso_normal_equations_profile_solves_like_a_dense_solve():
         U.sort_indices()
         f = backend.factorize(U, upper=True)
         np.testing.assert_allclose(f.solve(b), np.linalg.solve(K.toarray(), b), rtol=1e-9)
+    Js = sp.hstack([J[:, :59], sp.csr_matrix((90, 1))]).tocsr()
+    Ks = sp.csr_matrix(Js.T @ Js)
+    Ks.setdiag(Ks.diagonal())
+    with pytest.raises(IndefiniteMatrixError):
+        backend.factorize(Ks)
