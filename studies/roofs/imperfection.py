@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import functools
 import json
 import sys
 import time
@@ -122,13 +123,14 @@ def check(
     t0 = time.perf_counter()
     cp, flat_xy, _ = roofs.folded(family, state)
     sv, se = roofs.support_lines(cp, flat_xy, roofs.FAMILIES[family]["axis"])
-    model, S, _ = roofs.subdivided_roof(cp, sv, se, m, RULE)
+    grading = roofs.grading_of(cp)  # the refined study's sub-panels
+    model, S, _ = roofs.subdivided_roof(cp, sv, se, m, RULE, grading=grading)
     P = roofs.plan_load(model, roofs.Q)
     P = P + self_weight(model, roofs.DENSITY * roofs.MATERIAL["t"], g=(0.0, 0.0, -roofs.G))
     w0 = amplitude(name, cp)
     row: dict[str, Any] = {"family": family, "state": state, "m": m, "n_dof": 3 * model.n_nodes,
                            "imperfection": name, "panel_side": panel_side(cp),
-                           "amplitude": w0, "mode": mode}  # fmt: skip
+                           "amplitude": w0, "mode": mode, "grading": grading}  # fmt: skip
     try:
         buck = linear_buckling(model, P, S, n_modes=mode)
         if len(buck.factors) < mode:
@@ -162,6 +164,12 @@ def critical(row: dict[str, Any]) -> float | None:
     return None
 
 
+@functools.cache
+def _grading(fam: str, state: float) -> float:
+    """The sub-panel grading of a roof (:func:`roofs.grading_of`)."""
+    return roofs.grading_of(roofs.folded(fam, state)[0])
+
+
 def _key(fam: str, state: float, m: int, name: str, mode: int = 1) -> str:
     return f"{fam}/{state:g}/m{m}/{name}" + (f"/mode{mode}" if mode != 1 else "")
 
@@ -185,6 +193,8 @@ def run(
     todo = [(fam, state, name, mode) for name, mode in tasks for fam, state in roof_list]
     for k, (fam, state, name, mode) in enumerate(todo, 1):
         key = _key(fam, state, m, name, mode)
+        if key in store and store[key].get("grading", 1.0) != _grading(fam, state):
+            del store[key]  # cut into other sub-panels than the refined study's: again
         if key not in store:
             print(f"[{k}/{len(todo)}] {fam} {state:g} (m = {m}, w0 = {name}, mode {mode})",
                   file=sys.stderr, flush=True)  # fmt: skip

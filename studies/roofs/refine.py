@@ -92,39 +92,13 @@ GRADING = float(next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--gr
 
 
 def grading_of(cp) -> float:
-    """The grading of a roof's sub-panels: ``GRADING`` where every panel is a parallelogram
-    and creases of different directions meet at a vertex (the corners where the plate
-    solution concentrates, which grading resolves), else 1.
-
-    Triangles are not graded (:mod:`barhinge.pattern.subdivide`: the coupled rule passes
-    its patch test on graded triangles but converges more slowly there); graded trapezoids (the
-    arched Miura's panels) passed it but converged more slowly than equal ones (miura_arc 60
-    at m = 32: 21.9 kN/m/m graded with p = 2, 27.1 equal, shell 27.6); the pleats' parallel
-    creases meet nowhere, and their graded strips did not converge (pleats 30 at m = 2, 4, 8,
-    16: 278, 177, 216, 295 kN/m graded, 278, 320, 343, 355 equal)."""
-    X = np.asarray(cp.vertices3d, float)
-    for f in cp.faces:
-        if len(f) != 4:
-            return 1.0
-        P = X[list(f)]
-        if np.linalg.norm(P[0] - P[1] + P[2] - P[3]) > 1e-9 * np.linalg.norm(P[2] - P[0]):
-            return 1.0
-    return GRADING if crease_corners(cp) else 1.0
+    """The grading of a roof's sub-panels in this study (:func:`roofs.grading_of` with
+    ``GRADING``): the linear levels, the nonlinear checks and the imperfect roofs of
+    imperfection.py cut the panels alike."""
+    return roofs.grading_of(cp, GRADING)
 
 
-def crease_corners(cp) -> bool:
-    """Whether creases (M, V) of different directions meet at some vertex of the flat
-    pattern (directions parallel to within 1e-6 rad counted as one)."""
-    E = np.asarray(cp.edges, np.int64)[np.isin(np.asarray(cp.assignment), ("M", "V"))]
-    V = np.asarray(cp.vertices, float)[:, :2]
-    d = V[E[:, 1]] - V[E[:, 0]]
-    d /= np.linalg.norm(d, axis=1)[:, None]
-    ends, dirs = np.concatenate([E[:, 0], E[:, 1]]), np.concatenate([d, d])
-    order = np.argsort(ends, kind="stable")
-    ends, dirs = ends[order], dirs[order]
-    # at a vertex with creases of two directions, two neighbours in this order differ
-    cross = np.abs(dirs[1:, 0] * dirs[:-1, 1] - dirs[1:, 1] * dirs[:-1, 0])
-    return bool(np.any((ends[1:] == ends[:-1]) & (cross > 1e-6)))
+crease_corners = roofs.crease_corners
 
 
 #: no level above this many DOFs is run
@@ -209,7 +183,8 @@ def nonlinear_level(
     keep_path: bool = False,
     steps: int = NONLINEAR_STEPS,
 ) -> dict[str, Any]:
-    """The nonlinear check of a roof with every panel cut into ``m x m`` sub-panels, under
+    """The nonlinear check of a roof with every panel cut into ``m x m`` sub-panels (graded
+    as the linear levels, :func:`grading_of`), under
     the design load (uniform load plus self-weight): :func:`roofs.nonlinear_check`, stopped
     at the first loss of stability, first increment ``1 / steps`` of the load (recorded as
     ``first_increment``); beside it ``deflection_linear``, the largest deflection of the
@@ -219,11 +194,12 @@ def nonlinear_level(
     from barhinge.scene import self_weight
 
     t0 = time.perf_counter()
-    model, S, _ = roofs.subdivided_roof(cp, sv, se, m, RULE)
+    model, S, _ = roofs.subdivided_roof(cp, sv, se, m, RULE, grading=grading_of(cp))
     P = roofs.plan_load(model, roofs.Q)
     P = P + self_weight(model, roofs.DENSITY * roofs.MATERIAL["t"], g=(0.0, 0.0, -roofs.G))
     U, _ = linear_response(model, P, S)
-    row: dict[str, Any] = {"m": m, "membrane": MEMBRANE, "n_dof": 3 * model.n_nodes,
+    row: dict[str, Any] = {"m": m, "membrane": MEMBRANE, "grading": grading_of(cp),
+                           "n_dof": 3 * model.n_nodes,
                            "deflection_linear": float(np.max(-U[:, 2])),
                            "first_increment": 1.0 / steps}  # fmt: skip
     try:
@@ -255,17 +231,18 @@ def nonlinear(fam: str, state: float, done: list[dict], save=lambda rows: None) 
     ``save`` called after every new check. A check that loses stability or fails is run
     again from the first increment ``1 / FINE_STEPS``; that one is kept, with the coarse
     one's critical load factor as ``coarse_critical`` (or its failure as ``coarse_error``)."""
+    cp, flat_xy, _ = roofs.folded(fam, state)
     rows = [
         r
         for r in done
         if r.get("membrane") == MEMBRANE
+        and r.get("grading", 1.0) == grading_of(cp)
         and r["m"] in NONLINEAR_LEVELS
         and "instability_bracket" in r
     ]
     missing = [m for m in NONLINEAR_LEVELS if m not in {r["m"] for r in rows}]
     if not missing and not any(needs_second_look(r) for r in rows):
-        return rows  # all cached: the roof need not be formed again
-    cp, flat_xy, _ = roofs.folded(fam, state)
+        return rows  # all cached
     sv, se = roofs.support_lines(cp, flat_xy, roofs.FAMILIES[fam]["axis"])
     for m in NONLINEAR_LEVELS:
         r = next((x for x in rows if x["m"] == m), None)
@@ -1130,7 +1107,8 @@ def section(results: list[dict]) -> str:
             "",
             findings(results, coarse),
             "",
-            "Nonlinear check, one facet per panel (the comparison table) and refined: the load"
+            "Nonlinear check, one facet per panel (the comparison table) and refined (cut into"
+            " the linear levels' sub-panels): the load"
             " factor at which the path loses stability (a limit point, or the first state whose"
             " tangent has a negative eigenvalue), or *stable to 1*. On the refined panels the"
             " path stops at the first unstable state; the load factor given is the load maximum"

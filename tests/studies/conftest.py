@@ -26,3 +26,27 @@ def load_study() -> Callable[[str, str], ModuleType]:
         return mod
 
     return load
+
+
+class SubdivisionBuilt(Exception):
+    """Raised by the stand-in of :func:`subdivision_gradings` once a roof model is asked for."""
+
+
+@pytest.fixture
+def subdivision_gradings(monkeypatch) -> Callable[[ModuleType], list[float]]:
+    """``record(roofs)``: replace ``roofs.subdivided_roof`` (the study's shared module) by a
+    stand-in that records the ``grading`` it is asked for and raises ``record.built``
+    (:class:`SubdivisionBuilt`); returns the list it records into."""
+
+    def record(roofs: ModuleType) -> list[float]:
+        seen: list[float] = []
+
+        def built(*args, grading: float = 1.0, **kwargs):
+            seen.append(grading)
+            raise SubdivisionBuilt
+
+        monkeypatch.setattr(roofs, "subdivided_roof", built)
+        return seen
+
+    record.built = SubdivisionBuilt  # type: ignore[attr-defined]
+    return record

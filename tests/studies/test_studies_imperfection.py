@@ -157,3 +157,21 @@ def test_a_failed_check_is_run_again_with_the_finer_increment(study, monkeypatch
     assert calls == [study.STEPS, study.FINE_STEPS]
     assert row["error"] == "" and row["coarse_error"].startswith("arc-length increment 10")
     assert study.verdict(row) == f"loses stability at 0.775 (increment 1/{study.STEPS}: failed)"
+
+
+def test_imperfect_roofs_are_cut_as_the_refined_study(study, subdivision_gradings, tmp_path):
+    """The imperfect roof is the refined study's model: sub-panels graded on the Miura roofs
+    (:func:`roofs.grading_of`), equal on the pleats; a cached check cut otherwise is redone."""
+    import json
+
+    seen = subdivision_gradings(study.roofs)
+    for family, state in (("miura60", 30.0), ("pleats", 90.0)):
+        with pytest.raises(subdivision_gradings.built):
+            study.check(family, state, 2, "b/200")
+    assert seen == [2.0, 1.0]
+    # a cached check of equal sub-panels on a graded roof is not read back: checked again
+    cache = tmp_path / "imperfection_cache.json"
+    cache.write_text(json.dumps({study._key("miura60", 30.0, 2, "b/200"): {"grading": 1.0}}))
+    with pytest.raises(subdivision_gradings.built):
+        study.run([("miura60", 30.0)], 2, cache)
+    assert seen[-1] == 2.0

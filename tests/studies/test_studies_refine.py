@@ -384,3 +384,20 @@ def test_grading_goes_where_creases_of_two_directions_meet(study, family, graded
     cp, _, _ = study.roofs.folded(family, study.roofs.FAMILIES[family]["states"][0])
     assert study.crease_corners(cp) == (family not in ("pleats", "flat"))
     assert study.grading_of(cp) == (2.0 if graded else 1.0)
+
+
+def test_the_nonlinear_checks_cut_the_panels_as_the_linear_levels(
+    study, monkeypatch, subdivision_gradings
+):
+    """The refined nonlinear checks are made on the linear levels' sub-panels: graded on the
+    Miura roofs (they were once cut into equal ones), equal on the pleats."""
+    monkeypatch.setattr(study, "GRADING", 2.0)
+    seen = subdivision_gradings(study.roofs)
+    for family, state in (("miura60", 30.0), ("pleats", 90.0)):
+        cp, flat_xy, _ = study.roofs.folded(family, state)
+        sv, se = study.roofs.support_lines(cp, flat_xy, study.roofs.FAMILIES[family]["axis"])
+        with pytest.raises(subdivision_gradings.built):
+            study.level(cp, sv, se, 4)
+        with pytest.raises(subdivision_gradings.built):
+            study.nonlinear_level(cp, sv, se, 4)
+    assert seen == [2.0, 2.0, 1.0, 1.0]
