@@ -367,11 +367,16 @@ def ten_million_lines(big: dict | None, rows: list[dict], steps: int) -> list[st
     mem10 = base + (m1 - base) * scale**pm
     cells = int(round(np.sqrt(TEN_MILLION / 24.0), -1))  # N5B8 Miura: about 24 n^2 DOF
     ram = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**20
-    fits = (
-        f"That fits in this machine's {ram / 1024:.0f} GB"
-        if mem10 < ram
-        else f"That is beyond this machine's {ram / 1024:.0f} GB"
-    )
+    # an extrapolation from two sheets is rough: "fits" only with a fifth of the memory spare
+    if mem10 < 0.8 * ram:
+        fits = f"That fits in this machine's {ram / 1024:.1f} GB"
+    elif mem10 < ram:
+        fits = (
+            f"That is at the limit of this machine's {ram / 1024:.1f} GB (the estimate "
+            "leaves less than a fifth of it spare)"
+        )
+    else:
+        fits = f"That is beyond this machine's {ram / 1024:.1f} GB"
     return [
         "",
         "### A 10 M DOF sheet (estimate)",
@@ -379,7 +384,7 @@ def ten_million_lines(big: dict | None, rows: list[dict], steps: int) -> list[st
         f"Extrapolated from the two largest sheets measured above ({d0} and {d1} DOF): the "
         f"refactorisation grows like DOF^{pf:.2f} and the process's peak memory above the "
         f"libraries' {base:.0f} MB like DOF^{pm:.2f}. A sheet of 10 M DOF (a Miura of about "
-        f"{cells} x {cells} cells) would need about {mem10 / 1024:.0f} GB and "
+        f"{cells} x {cells} cells) would need about {mem10 / 1024:.1f} GB and "
         f"{fact10 / 60:.0f} min per refactorisation, so {steps * fact10 / 3600:.1f} h for the "
         f"floor of a {steps}-step fold on one node of this kind. {fits}; a larger sheet needs "
         "a node with more memory (MKL PARDISO also factorises out of core), or a distributed "

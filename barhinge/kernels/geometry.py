@@ -36,6 +36,8 @@ two and both against finite differences.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from barhinge._typing import StrainMeasure
@@ -364,7 +366,7 @@ def hinge_angle_hessian_packed(
 
 
 def hinge_energy_hessian_packed(
-    X: np.ndarray, hinges: np.ndarray, law, out: np.ndarray | None = None, chunk: int = 8192
+    X: np.ndarray, hinges: np.ndarray, law, out: Any = None, chunk: int = 8192
 ):
     """Fast path of the assembly: hinge energy derivatives, component-major.
 
@@ -372,7 +374,9 @@ def hinge_energy_hessian_packed(
     ----------
     law : callable ``(rho, sl) -> (M, dM/drho, W)``: the law of the hinges ``sl`` (a slice
         of ``hinges``) at their angles ``rho``, each result of the slice's length
-    out : optional (78, nh) float array to write the packed Hessian into
+    out : optional (78, nh) float array to write the packed Hessian into, or any object
+        whose ``out[p]`` is a writable ``(nh,)`` row and ``out[:, sl]`` those rows of the
+        hinges ``sl`` (the assembler's :class:`~barhinge.assembly.PackedRows`)
     chunk : hinges per pass (keeps the working vectors in cache; a loop over chunks, not
         elements)
 

@@ -259,7 +259,8 @@ class BorderedSystem:
         newidx = np.full(n, -1, np.int64)
         newidx[self.free_idx] = np.arange(len(self.free_idx))
         keep = self.free[rows] & self.free[cols]
-        self._sel = np.flatnonzero(keep)
+        itype = np.int32 if K.nnz < 2**31 - 1 else np.int64
+        self._sel = np.flatnonzero(keep).astype(itype)
         r, c = newidx[rows[keep]], newidx[cols[keep]]
         nf = len(self.free_idx)
         self._sub_indptr = np.concatenate([[0], np.cumsum(np.bincount(r, minlength=nf))])
@@ -383,7 +384,8 @@ class BorderedSystem:
             from_k = src < nnz_k
             # one take from K's values (the few G and zero entries read position 0 and are
             # overwritten): no copy of K's values into a concatenated source
-            self._kkt_gather = np.where(from_k, src, 0)
+            itype = np.int32 if nnz_k < 2**31 - 1 else np.int64
+            self._kkt_gather = np.where(from_k, src, 0).astype(itype)
             self._kkt_g = (np.flatnonzero(~from_k), src[~from_k] - nnz_k)  # G, then the zero
             self._kkt_pattern = (tags.indices, tags.indptr, tags.shape)
             self._kkt_key = key

@@ -280,3 +280,38 @@ def test_hinge_couplings_keep_the_scatter_maps_small() -> None:
     assert len(coupled.hinge_pairs) > 2 * coupled.n_hinges
     a, b = plain.assembler, coupled.assembler
     assert b.nbytes <= a.nbytes + 12 * (b.nnz - a.nnz)
+
+
+def test_block_layout_rows_and_packed_lists_assemble_the_same_dense_sum() -> None:
+    """The assembler's block layout against a dense sum written here: random symmetric element
+    matrices on elements whose node order is both ascending and descending (the swapped
+    node pairs add their blocks transposed), given as packed lists and written row by row
+    through ``value_buffers``; the maps hold one entry per node pair of an element."""
+    from barhinge.assembly import Assembler, element_dofs
+
+    rng = np.random.default_rng(7)
+    n_nodes = 9
+    groups = [rng.permuted(np.tile(np.arange(n_nodes), (6, 1)), axis=1)[:, :k] for k in (2, 4)]
+    asm = Assembler(n_nodes, groups)
+    dense = np.zeros((3 * n_nodes, 3 * n_nodes))
+    packed = []
+    for conn in groups:
+        m = 3 * conn.shape[1]
+        A = rng.normal(size=(len(conn), m, m))
+        Ke = A + A.transpose(0, 2, 1)
+        for dofs, k in zip(element_dofs(conn), Ke, strict=True):
+            dense[np.ix_(dofs, dofs)] += k
+        iu, ju = np.triu_indices(m)
+        packed.append(Ke[:, iu, ju].T)
+    K_list = asm.matrix_packed(packed).toarray()
+    flat, views = asm.value_buffers()
+    for view, P in zip(views, packed, strict=True):
+        for p in range(len(P)):
+            view[p][...] = P[p]
+    K_rows = asm.matrix_packed(flat).toarray()
+    assert np.abs(K_list - dense).max() <= 1e-13 * np.abs(dense).max()
+    assert np.array_equal(K_rows, K_list) and np.array_equal(K_list, K_list.T)
+    pairs = sum(len(c) * c.shape[1] * (c.shape[1] + 1) // 2 for c in groups)
+    assert asm._sum_direct.nnz + asm._sum_swapped.nnz == pairs
+    with pytest.raises(ValueError, match="flat value array"):
+        asm.matrix_packed(np.zeros(5))
