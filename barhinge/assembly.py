@@ -69,13 +69,6 @@ class PackedRows:
         self.comp = comp  # (n_packed,) block component of each packed entry
         self.pair = pair  # (n_packed,) node pair of each packed entry
 
-    @property
-    def shape(self) -> tuple[int, int]:
-        return len(self.comp), self.buf.shape[2]
-
-    def __len__(self) -> int:
-        return len(self.comp)
-
     def __getitem__(self, key: int | tuple[slice, slice]) -> Any:
         if isinstance(key, tuple):
             rows, cols = key
@@ -83,10 +76,6 @@ class PackedRows:
                 raise IndexError("PackedRows takes rows[p] or rows[:, slice]")
             return PackedRows(self.buf[:, :, cols], self.comp, self.pair)
         return self.buf[self.comp[key], self.pair[key]]
-
-    def toarray(self) -> np.ndarray:
-        """(n_packed, n_el) copy in packed order."""
-        return self.buf[self.comp, self.pair]
 
 
 class Assembler:
@@ -170,7 +159,7 @@ class Assembler:
         del swapped, inv
         self._n_blocks = nblk
 
-        # 3. full symmetric CSR pattern from the blocks, and the gather from the slots
+        # 3. full symmetric CSR pattern from the blocks, and the gather from the block sums
         bA, bB = (ublk // N).astype(itype), (ublk % N).astype(itype)
         del ublk
         offd = bA != bB
