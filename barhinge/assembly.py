@@ -26,6 +26,8 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
+from barhinge.linalg.indices import index_dtype
+
 __all__ = ["Assembler", "PackedRows", "element_dofs"]
 
 #: structures of added matrices whose positions an Assembler keeps (:meth:`add_entries`;
@@ -115,7 +117,7 @@ class Assembler:
         nblk = len(ublk)
         self.n_upper = 9 * nblk  # a 3x3 slot per node-pair block (upper part on diagonals)
         # index dtype of every map below: int32 wherever the counts allow (halves the maps)
-        itype = np.int32 if max(n_packed, 2 * self.n_upper, n) < 2**31 - 1 else np.int64
+        itype = index_dtype(n_packed, 2 * self.n_upper, n)
         inv = inv.ravel()[:n_valued].astype(itype)
         self._fdofs = self._fdofs.astype(itype)
         self.dofs = [D.astype(itype) for D in self.dofs]
@@ -323,7 +325,7 @@ class Assembler:
         seen = np.zeros(self.nnz, bool)
         seen[pos_up] = True
         if np.count_nonzero(seen) == pos_up.size:  # no position stored twice
-            itype = np.int32 if max(self.nnz, M.nnz) < 2**31 - 1 else np.int64
+            itype = index_dtype(self.nnz, M.nnz)
             result = (
                 up.astype(itype),
                 pos_up.astype(itype),

@@ -56,6 +56,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components, dijkstra
 
 from barhinge.errors import PatternError
+from barhinge.linalg.indices import index_dtype
 from barhinge.pattern.crease import CreasePattern
 
 __all__ = [
@@ -321,7 +322,7 @@ class RigidConstraints:
         order = np.lexsort((c, r))
         counts = np.bincount(r, minlength=self.n_eq)
         indptr = np.concatenate([[0], np.cumsum(counts)])
-        idx = np.int32 if r.size < 2**31 else np.int64  # scipy's own choice: no copies
+        idx = index_dtype(r.size)  # scipy's own choice: no copies
         return indptr.astype(idx), c[order].astype(idx), order, vmask
 
     @cached_property
@@ -347,7 +348,7 @@ class RigidConstraints:
             np.concatenate([keys, np.arange(n) * (n + 1)]), return_inverse=True
         )
         k_indptr = np.concatenate([[0], np.cumsum(np.bincount(unique // n, minlength=n))])
-        idx = np.int32 if unique.size < 2**31 else np.int64  # scipy's own choice: no copies
+        idx = index_dtype(unique.size)  # scipy's own choice: no copies
         return (
             k_indptr.astype(idx),
             (unique % n).astype(idx),

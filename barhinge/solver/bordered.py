@@ -43,6 +43,7 @@ import scipy.sparse.linalg as spla
 
 from barhinge._protocols import SolverModel
 from barhinge.linalg.backends import LinearBackend, SingularMatrixError
+from barhinge.linalg.indices import index_dtype
 from barhinge.linalg.inertia import InertiaCounter
 
 __all__ = ["ActuatorTerms", "BorderedSystem", "Timer", "actuator_terms", "hinge_derivatives"]
@@ -259,7 +260,7 @@ class BorderedSystem:
         newidx = np.full(n, -1, np.int64)
         newidx[self.free_idx] = np.arange(len(self.free_idx))
         keep = self.free[rows] & self.free[cols]
-        itype = np.int32 if K.nnz < 2**31 - 1 else np.int64
+        itype = index_dtype(K.nnz)
         self._sel = np.flatnonzero(keep).astype(itype)
         r, c = newidx[rows[keep]], newidx[cols[keep]]
         nf = len(self.free_idx)
@@ -384,7 +385,7 @@ class BorderedSystem:
             from_k = src < nnz_k
             # one take from K's values (the few G and zero entries read position 0 and are
             # overwritten): no copy of K's values into a concatenated source
-            itype = np.int32 if nnz_k < 2**31 - 1 else np.int64
+            itype = index_dtype(nnz_k)
             self._kkt_gather = np.where(from_k, src, 0).astype(itype)
             self._kkt_g = (np.flatnonzero(~from_k), src[~from_k] - nnz_k)  # G, then the zero
             self._kkt_pattern = (tags.indices, tags.indptr, tags.shape)
