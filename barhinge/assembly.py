@@ -33,6 +33,10 @@ __all__ = ["Assembler", "PackedRows", "element_dofs"]
 #: structures of added matrices whose positions an Assembler keeps (:meth:`add_entries`;
 #: the least recently used goes first)
 ENTRY_STRUCTURES = 2
+#: a value buffer up to this size is kept between evaluations (bytes); a larger one (about
+#: 0.9 GB at 1 M DOF) is allocated by every evaluation and freed with it, so it does not
+#: stay beside the factorisation, whose memory peak sets the largest model a machine takes
+KEEP_SCRATCH_BYTES = 256 * 2**20
 
 
 def element_dofs(conn: np.ndarray) -> np.ndarray:
@@ -237,13 +241,17 @@ class Assembler:
         ``views[g][p]`` (``(n_el,)``, writable), holds entry ``p`` of the packed upper
         triangle (``numpy.triu_indices(m)`` order) of every element matrix of the group. Write
         the element values into the rows and pass the flat array to :meth:`matrix_packed`
-        (saves a copy). The buffer is allocated once and reused by every call (scratch only:
-        the matrices returned own their data), so one Assembler must not be used from two
-        threads at once."""
-        if getattr(self, "_flat", None) is None:
+        (saves a copy). A buffer of up to ``KEEP_SCRATCH_BYTES`` is allocated once and reused
+        by every call (scratch only: the matrices returned own their data), so one Assembler
+        must not be used from two threads at once; a larger one is new at every call and
+        freed with the caller's reference."""
+        flat = getattr(self, "_flat", None)
+        if flat is None:
             # zeros: the lower components of the diagonal blocks are never written
-            self._flat = np.zeros(9 * self.n_instances)
-        return self._flat, self._group_views(self._flat)
+            flat = np.zeros(9 * self.n_instances)
+            if flat.nbytes <= KEEP_SCRATCH_BYTES:
+                self._flat = flat
+        return flat, self._group_views(flat)
 
     def matrix_packed(self, element_upper: list[np.ndarray] | np.ndarray) -> sp.csr_matrix:
         """(n_dof, n_dof) CSR sum of symmetric element matrices given by their packed upper

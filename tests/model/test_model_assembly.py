@@ -315,3 +315,29 @@ def test_block_layout_rows_and_packed_lists_assemble_the_same_dense_sum() -> Non
     assert asm._sum_direct.nnz + asm._sum_swapped.nnz == pairs
     with pytest.raises(ValueError, match="flat value array"):
         asm.matrix_packed(np.zeros(5))
+
+
+def test_value_buffer_above_the_kept_size_is_new_at_every_evaluation(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A value buffer larger than ``KEEP_SCRATCH_BYTES`` is not kept between evaluations (so
+    it is not held beside the factorisation) and gives the same tangent, twice in a row, as
+    the kept one."""
+    import barhinge.assembly as assembly
+
+    cp = bh.families.miura(3, 3, alpha=60.0, fold=40.0)
+    tangents = []
+    for keep in (10**9, 0):
+        monkeypatch.setattr(assembly, "KEEP_SCRATCH_BYTES", keep)
+        model = bh.BarHingeModel.from_pattern(cp, "N5B8")
+        X = model.X0 + 1e-3 * np.random.default_rng(3).standard_normal(model.X0.shape)
+        first = model.evaluate(X).K
+        flat_a, _ = model.assembler.value_buffers()
+        flat_b, _ = model.assembler.value_buffers()
+        assert (flat_a is flat_b) == (keep > 0)
+        assert (getattr(model.assembler, "_flat", None) is None) == (keep == 0)
+        tangents += [first, model.evaluate(X).K]
+    ref = tangents[0].toarray()
+    assert np.abs(ref).max() > 0
+    for K in tangents[1:]:
+        assert np.array_equal(K.toarray(), ref)
