@@ -242,6 +242,11 @@ class BorderedSystem:
         self._penalty_blocks: np.ndarray | None = None
         self._released: tuple[np.ndarray, np.ndarray] | None = None
         self._released_counter: InertiaCounter | None = None
+        #: release a bordered factor larger than ``InertiaCounter.RELEASE_ABOVE`` before the
+        #: released tangent is factorised (the two are then never held together): for
+        #: callers whose next solve follows a new factorisation (the increments of parameter
+        #: control), not for arc length, whose next increment solves with this factor
+        self.release_before_count = False
 
     # ---------------------------------------------------------------- structure
     def _prepare(self, K: sp.csr_matrix) -> None:
@@ -518,6 +523,8 @@ class BorderedSystem:
         backend gives no inertia."""
         assert self._released is not None and self._blk_pos is not None
         assert self._sel is not None and self._sub_indptr is not None
+        if self.release_before_count:
+            self._release_large_factor()
         data, pen = self._released
         released = data.copy()
         np.add.at(released, self._blk_pos, -pen.ravel())
@@ -536,6 +543,18 @@ class BorderedSystem:
             self.timer.factorize += time.perf_counter() - t0
             self.timer.n_factorizations += counter.factorizations - made
 
+    def _release_large_factor(self) -> None:
+        """Free the bordered factor when it is larger than ``InertiaCounter.RELEASE_ABOVE``
+        (the backend keeps its ordering and analysis); the next operator is factorised
+        afresh. A no-op for a backend that cannot release its factor."""
+        size = getattr(self.backend, "factor_bytes", None)
+        if size is None or size() <= InertiaCounter.RELEASE_ABOVE:
+            return
+        self.backend.release()  # type: ignore[attr-defined]
+        self.factor = None
+        self.direct = None
+        self.current_factored = False
+
     # ---------------------------------------------------------------- solve
     def solve(
         self, rhs_x: np.ndarray, rhs_c: np.ndarray, rtol: float = 1e-10
@@ -549,6 +568,8 @@ class BorderedSystem:
         """
         t0 = time.perf_counter()
         self.last_krylov_iters = 0
+        if self.direct is None:  # released (release_before_count): factorise this operator
+            self._factorize_current()
         if self.current_factored:
             assert self.direct is not None  # current_factored: kept by _keep
             out = self.direct.solve(rhs_x, rhs_c)

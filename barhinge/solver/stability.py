@@ -38,6 +38,9 @@ class InertiaMonitor:
         control = ctx.scene.control
         self.inertia: int | None = None  # negative pivots at the last converged state
         ctx.system.track_inertia = control in ("load", "displacement")
+        # every increment of parameter control factorises before it solves: a large bordered
+        # factor can go before the released tangent is factorised for its count
+        ctx.system.release_before_count = control != "arc_length"
         # what a change of the free-DOF tangent's inertia means under this control: a load
         # maximum (load control) or a turning point of the controlled displacement
         self.critical = "limit point" if control == "load" else "snap-back"

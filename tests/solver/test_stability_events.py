@@ -84,6 +84,46 @@ def test_released_inertia_from_the_bordered_factorisation_matches_dense(name, ro
         assert took == (route == "released factor" and saddle), name
 
 
+@pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO releases factors")
+def test_released_bordered_factor_gives_the_same_fold(monkeypatch):
+    """Above ``InertiaCounter.RELEASE_ABOVE`` the bordered factor is released before the
+    released tangent is factorised for the stability count (never two factors at once):
+    the fold (a 3 x 3 Miura with 6 line actuators on the released-factor route, 8 steps
+    from 50 deg) is the same state for state, with the same counts, as with every factor
+    kept; the released factors are really released, and arc length keeps its factor."""
+    from barhinge.linalg import inertia
+    from barhinge.linalg.backends import PardisoBackend
+    from barhinge.solver import bordered
+
+    monkeypatch.setattr(bordered, "RELEASED_FACTOR_MIN_ACT", 1)
+    cp = bh.families.miura(3, 3, alpha=60.0, fold=50.0)
+    model = BarHingeModel.from_pattern(cp, "N5B8", fold_stiffness=0.1, bar_EA=1e3)
+    edges = miura_line_creases(cp)
+    targets = np.asarray(bh.families.miura(3, 3, alpha=60.0, fold=20.0).fold_angles)[edges]
+    scene = Scene(
+        model,
+        actuators=bh.Actuators(edges=edges, targets_deg=targets),
+        steps=8,
+        options={"linear_solver": "pardiso"},
+    )
+    released = []
+    real_release = PardisoBackend.release
+    monkeypatch.setattr(
+        PardisoBackend, "release", lambda self: (released.append(self), real_release(self))[1]
+    )
+    kept = bh.solve(scene)
+    assert not released
+    monkeypatch.setattr(inertia.InertiaCounter, "RELEASE_ABOVE", 0)
+    freed = bh.solve(scene)
+    assert len(released) >= 2 * scene.steps  # the count's factors and the bordered ones
+    assert freed.meta["negative_eigenvalues"] == kept.meta["negative_eigenvalues"]
+    scale = float(np.abs(kept.X[0]).max())
+    assert np.abs(freed.X - kept.X).max() <= 1e-9 * scale
+    assert np.abs(kept.X[-1] - kept.X[0]).max() > 0.05 * scale  # it folded
+    ctx_arc = newton._Driver(_vm_scene(steps=2)).ctx
+    assert not ctx_arc.system.release_before_count
+
+
 def test_stability_check_option_is_validated():
     with pytest.raises(ConfigError, match="stability_check"):
         SolverOptions(stability_check="yes")
