@@ -526,10 +526,15 @@ class BorderedSystem:
         if self.release_before_count:
             self._release_large_factor()
         data, pen = self._released
-        released = data.copy()
-        np.add.at(released, self._blk_pos, -pen.ravel())
+        # the free submatrix's values (one copy), the penalty blocks taken off where their
+        # entries are free (``_sel`` is sorted)
+        vals = data[self._sel]
+        sub = np.searchsorted(self._sel, self._blk_pos)
+        free = sub < len(vals)
+        free[free] = self._sel[sub[free]] == self._blk_pos[free]
+        np.add.at(vals, sub[free], -pen.ravel()[free])
         nf = len(self.free_idx)
-        Kt = sp.csr_matrix((released[self._sel], self._sub_indices, self._sub_indptr), (nf, nf))
+        Kt = sp.csr_matrix((vals, self._sub_indices, self._sub_indptr), (nf, nf))
         if self._released_counter is None:
             self._released_counter = InertiaCounter(self.backend)
         counter = self._released_counter
