@@ -224,7 +224,12 @@ class BorderedSystem:
         self.negative_pivots: int | None = None
         self.inertia_seen: list[int | None] = []
         # current operator (exact tangent of the current iterate)
-        self._data_full: np.ndarray | None = None  # K's values + actuator blocks
+        # the current operator's values: K's (no copy) and the actuator blocks added to them
+        # where they are needed (the saddle-point path adds them after its gather)
+        self._values: np.ndarray | None = None
+        self._blocks: np.ndarray = np.zeros((0, 12, 12))
+        self._full: np.ndarray | None = None  # K's values + the blocks (built on first use)
+        self._kkt_blk: tuple[np.ndarray, np.ndarray] | None = None  # blocks -> KKT values
         self._A: sp.csr_matrix | None = None
         self.Gf: sp.csr_matrix | None = None
         self.penalty = 0.0
@@ -283,9 +288,11 @@ class BorderedSystem:
             self._blk_ok = True
             self._blk_pos = np.zeros(0, np.int64)
 
-    def _free_data(self, K: sp.csr_matrix, blocks: np.ndarray) -> np.ndarray:
-        """Values of K (its CSR pattern) plus the actuator blocks (n_act, 12, 12)."""
+    def _set_values(self, K: sp.csr_matrix, blocks: np.ndarray) -> None:
+        """Make K's values (its CSR pattern; not copied) and the actuator blocks
+        ``(n_act, 12, 12)`` the current operator's."""
         self._prepare(K)
+        self._full = None
         if len(blocks) and not self._blk_ok:
             # the model's pattern does not hold the blocks: add them as a sparse matrix
             ad = self.act_dofs
@@ -295,22 +302,31 @@ class BorderedSystem:
             K = (K + B).tocsr()
             self._key = None
             self._prepare(K)
-            return K.data
-        if len(blocks):
-            data = K.data.copy()
-            assert self._blk_pos is not None  # set by _prepare
-            np.add.at(data, self._blk_pos, blocks.ravel())
-            return data
-        return K.data
+            blocks = np.zeros((0, 12, 12))
+        self._values, self._blocks = K.data, blocks
+
+    def _full_values(self) -> np.ndarray:
+        """K's values plus the actuator blocks (a copy of K's values when there are
+        blocks, made on first use)."""
+        assert self._values is not None  # an operator was set
+        if self._full is None:
+            if len(self._blocks):
+                assert self._blk_pos is not None  # set by _prepare
+                self._full = self._values.copy()
+                np.add.at(self._full, self._blk_pos, self._blocks.ravel())
+            else:
+                self._full = self._values
+        return self._full
 
     @property
     def A(self) -> sp.csr_matrix | None:
         """The current free-DOF operator ``K_ff + sum mu_a H_a + p G^T G`` (built on first
         use: the saddle-point path gathers its matrix straight from K's values)."""
-        if self._A is None and self._data_full is not None:
+        if self._A is None and self._values is not None:
             nf = len(self.free_idx)
             self._A = sp.csr_matrix(
-                (self._data_full[self._sel], self._sub_indices, self._sub_indptr), shape=(nf, nf)
+                (self._full_values()[self._sel], self._sub_indices, self._sub_indptr),
+                shape=(nf, nf),
             )
         return self._A
 
@@ -345,7 +361,7 @@ class BorderedSystem:
             blocks = mu[:, None, None] * terms.hess + self._penalty_blocks
         else:
             blocks = np.zeros((0, 12, 12))
-        self._data_full = self._free_data(K, blocks)
+        self._set_values(K, blocks)
         self._A = None
         self.Gf = terms.G[:, self.free_idx].tocsr() if na else None
         self.penalty = penalty
@@ -367,9 +383,9 @@ class BorderedSystem:
         Its pattern is built once (entries tagged with their source position in K's values
         or G's) and every later call is one gather from K's values and G's."""
         G = self.Gf
-        assert G is not None and self._data_full is not None  # an operator with actuators
+        assert G is not None and self._values is not None  # an operator with actuators
         assert self._sel is not None and self._sub_indptr is not None
-        na, nnz_k, nnz_g = G.shape[0], len(self._data_full), G.nnz
+        na, nnz_k, nnz_g = G.shape[0], len(self._values), G.nnz
         key = (self._key, upper, nnz_g, hash(G.indptr.tobytes()), hash(G.indices.tobytes()))
         if key != self._kkt_key:
             nf = len(self.free_idx)
@@ -394,16 +410,41 @@ class BorderedSystem:
             self._kkt_gather = np.where(from_k, src, 0).astype(itype)
             self._kkt_g = (np.flatnonzero(~from_k), src[~from_k] - nnz_k)  # G, then the zero
             self._kkt_pattern = (tags.indices, tags.indptr, tags.shape)
+            self._kkt_blk = self._kkt_block_positions(tags.indptr, tags.indices, upper)
             self._kkt_key = key
         assert self._kkt_pattern is not None and self._kkt_g is not None
         assert self._kkt_gather is not None
         indices, indptr, shape = self._kkt_pattern
-        data = self._data_full.take(self._kkt_gather)
+        data = self._values.take(self._kkt_gather)
+        if len(self._blocks):  # the actuator blocks, added here: no copy of K's values
+            assert self._kkt_blk is not None  # set with the pattern
+            entry, at = self._kkt_blk
+            np.add.at(data, at, self._blocks.ravel()[entry])
         pos, idx = self._kkt_g
         data[pos] = np.append(G.data, 0.0)[idx]
         kkt = sp.csr_matrix((data, indices, indptr), shape=shape)
         kkt.has_sorted_indices = True
         return kkt
+
+    def _kkt_block_positions(
+        self, indptr: np.ndarray, indices: np.ndarray, upper: bool
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(entries of the flattened actuator blocks, their positions in the bordered
+        matrix's values) for the bordered pattern ``(indptr, indices)``: the entries whose
+        DOFs are both free (and, for the upper triangle, whose row is not after the
+        column)."""
+        ad = self.act_dofs
+        newidx = np.full(self.n_dof, -1, np.int64)
+        newidx[self.free_idx] = np.arange(len(self.free_idx))
+        r = newidx[np.repeat(ad, 12, axis=1).ravel()]
+        c = newidx[np.tile(ad, (1, 12)).ravel()]
+        keep = (r >= 0) & (c >= 0)
+        if upper:
+            keep &= r <= c
+        entry = np.flatnonzero(keep)
+        at = _pattern_positions(indptr, indices, r[entry], c[entry])
+        assert np.all(at >= 0)  # the bordered pattern holds A's, which holds the blocks
+        return entry, at
 
     def _factorize_current(self) -> None:
         t_start = time.perf_counter()
@@ -511,8 +552,8 @@ class BorderedSystem:
         self._record_inertia(na)  # inertia(KKT) = inertia(A) + inertia(-S), S > 0 when A > 0
         self._keep(_KKTSolver(self.factor, self.Gf, self.penalty), t_start)
         self._released = None
-        if self._blk_ok and self._penalty_blocks is not None and self._data_full is not None:
-            self._released = (self._data_full, self._penalty_blocks)
+        if self._blk_ok and self._penalty_blocks is not None and self._values is not None:
+            self._released = (self._values, self._blocks - self._penalty_blocks)
         return True
 
     def _released_inertia(self) -> int | None:
@@ -525,14 +566,14 @@ class BorderedSystem:
         assert self._sel is not None and self._sub_indptr is not None
         if self.release_before_count:
             self._release_large_factor()
-        data, pen = self._released
-        # the free submatrix's values (one copy), the penalty blocks taken off where their
-        # entries are free (``_sel`` is sorted)
+        data, blocks = self._released
+        # the free submatrix of K's values (one copy), the blocks ``mu_a H_a`` added where
+        # their entries are free (``_sel`` is sorted)
         vals = data[self._sel]
         sub = np.searchsorted(self._sel, self._blk_pos)
         free = sub < len(vals)
         free[free] = self._sel[sub[free]] == self._blk_pos[free]
-        np.add.at(vals, sub[free], -pen.ravel()[free])
+        np.add.at(vals, sub[free], blocks.ravel()[free])
         nf = len(self.free_idx)
         Kt = sp.csr_matrix((vals, self._sub_indices, self._sub_indptr), (nf, nf))
         if self._released_counter is None:
@@ -672,13 +713,21 @@ class BorderedSystem:
 def _csr_positions(K: sp.csr_matrix, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
     """Index into ``K.data`` of each (row, col) pair, -1 where the pattern has no entry.
     K must have sorted indices."""
+    return _pattern_positions(K.indptr, K.indices, rows, cols)
+
+
+def _pattern_positions(
+    indptr: np.ndarray, indices: np.ndarray, rows: np.ndarray, cols: np.ndarray
+) -> np.ndarray:
+    """Index into the values of the CSR pattern ``(indptr, indices)`` (sorted indices) of
+    each (row, col) pair, -1 where the pattern has no entry."""
     out = np.full(len(rows), -1, np.int64)
-    start = K.indptr[rows]
-    end = K.indptr[rows + 1]
+    start = indptr[rows]
+    end = indptr[rows + 1]
     for q in range(len(rows)):  # small: 144 entries per actuator
         s, e = start[q], end[q]
-        k = s + np.searchsorted(K.indices[s:e], cols[q])
-        if k < e and K.indices[k] == cols[q]:
+        k = s + np.searchsorted(indices[s:e], cols[q])
+        if k < e and indices[k] == cols[q]:
             out[q] = k
     return out
 
