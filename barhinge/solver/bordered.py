@@ -277,11 +277,8 @@ class BorderedSystem:
         self._sub_indptr = np.concatenate([[0], np.cumsum(np.bincount(r, minlength=nf))])
         self._sub_indices = c.astype(np.int32)
         # positions of the actuator 12x12 blocks inside K.data (if K's pattern holds them)
-        ad = self.act_dofs
-        if len(ad):
-            br = np.repeat(ad, 12, axis=1).ravel()
-            bc = np.tile(ad, (1, 12)).ravel()
-            pos = _csr_positions(K, br, bc)
+        if len(self.act_dofs):
+            pos = _csr_positions(K, *_block_entries(self.act_dofs))
             self._blk_ok = bool(np.all(pos >= 0))
             self._blk_pos = pos
         else:
@@ -295,10 +292,7 @@ class BorderedSystem:
         self._full = None
         if len(blocks) and not self._blk_ok:
             # the model's pattern does not hold the blocks: add them as a sparse matrix
-            ad = self.act_dofs
-            br = np.repeat(ad, 12, axis=1).ravel()
-            bc = np.tile(ad, (1, 12)).ravel()
-            B = sp.csr_matrix((blocks.ravel(), (br, bc)), shape=K.shape)
+            B = sp.csr_matrix((blocks.ravel(), _block_entries(self.act_dofs)), shape=K.shape)
             K = (K + B).tocsr()
             self._key = None
             self._prepare(K)
@@ -433,11 +427,10 @@ class BorderedSystem:
         matrix's values) for the bordered pattern ``(indptr, indices)``: the entries whose
         DOFs are both free (and, for the upper triangle, whose row is not after the
         column)."""
-        ad = self.act_dofs
         newidx = np.full(self.n_dof, -1, np.int64)
         newidx[self.free_idx] = np.arange(len(self.free_idx))
-        r = newidx[np.repeat(ad, 12, axis=1).ravel()]
-        c = newidx[np.tile(ad, (1, 12)).ravel()]
+        rows, cols = _block_entries(self.act_dofs)
+        r, c = newidx[rows], newidx[cols]
         keep = (r >= 0) & (c >= 0)
         if upper:
             keep &= r <= c
@@ -708,6 +701,12 @@ class BorderedSystem:
         if info != 0 or z is None or not np.all(np.isfinite(z)):
             return None
         return z[:nf], s * z[nf:]
+
+
+def _block_entries(act_dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(rows, columns) of every entry of the actuators' 12 x 12 blocks ``(n_act, 12, 12)``,
+    flattened in the blocks' order (``act_dofs``: (n_act, 12) global DOFs)."""
+    return np.repeat(act_dofs, 12, axis=1).ravel(), np.tile(act_dofs, (1, 12)).ravel()
 
 
 def _csr_positions(K: sp.csr_matrix, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
