@@ -131,15 +131,16 @@ class SolverOptions:
         Default False.
     stability_check : bool or None
         How the inertia of the free-DOF tangent (its number of negative eigenvalues, actuators
-        released) is found at every recorded state (``FoldPath.meta["negative_eigenvalues"]``
-        and the stability events). True: the tangent *at* the state is factorised (exact;
+        released, and with held actuators also held) is found at every recorded state
+        (``FoldPath.meta["negative_eigenvalues"]``, ``["negative_eigenvalues_held"]`` and the
+        stability events). True: the tangent *at* the state is factorised (exact;
         one extra factorisation per state, except under arc length, whose next increment
         uses the same one). False: the count comes from the last factorisation Newton made
         in the increment (free: the tangent one iterate before convergence), confirmed by a
-        factorisation at the state whenever it differs from the previous state's count or
-        is unknown (e.g. with ``reuse_factorization``): no false events, but a change may be
-        reported one step late. None (default): True under load and arc-length control,
-        False under fold-angle and displacement control.
+        factorisation at the state whenever either count differs from the previous
+        state's or is unknown (e.g. with ``reuse_factorization``): no false events, but a
+        change may be reported one step late. None (default): True under load and
+        arc-length control, False under fold-angle and displacement control.
     flat_start : str
         How an actuated scene leaves a flat (singular) start, where the tangent predictor
         cannot see the folding mode: ``"rigid"`` (default) predicts the first increment by

@@ -877,6 +877,38 @@ def von_mises_model(a: float = _VMA, h: float = _VMH, EA: float = _VMEA, spring:
     return model, S, 2
 
 
+def rigid_link_strut(
+    n: int, ell: float = 1.0, b: float = 0.5, k: float = 2.0, rigid: float = 1e7
+) -> tuple[BarHingeModel, np.ndarray, np.ndarray]:
+    """A strip of ``n`` panels ``ell x b`` in a row along x, joined by ``n - 1`` transverse
+    creases of rotational stiffness ``k``; panels (bars and bending) ``rigid``: a strut of
+    rigid links, pinned at x = 0 (the line can rotate about y), on rollers along x at the
+    other end.
+
+    Returns (model, supports (n_nodes, 3) bool, load (n_nodes, 3): unit axial compression
+    at the roller end).
+    """
+    xs = ell * np.arange(n + 1)
+    V = np.vstack(
+        [np.column_stack([xs, np.zeros(n + 1)]), np.column_stack([xs, np.full(n + 1, b)])]
+    )
+    top = n + 1  # vertex i + top lies above vertex i (y = b)
+    edges = [(i, i + 1) for i in range(n)] + [(top + i, top + i + 1) for i in range(n)]
+    edges += [(i, top + i) for i in range(n + 1)]
+    asg = ["B"] * (2 * n) + ["B" if i in (0, n) else "V" for i in range(n + 1)]
+    faces = [[i, i + 1, top + i + 1, top + i] for i in range(n)]
+    cp = CreasePattern(V, edges, asg, faces=faces)
+    m = BarHingeModel.from_pattern(
+        cp, "N4B5", Material(E=1.0, nu=0.3, t=0.01), bar_EA=rigid, bend_k=rigid, fold_k=k
+    )
+    S = np.zeros((m.n_nodes, 3), bool)
+    S[[0, top]] = True  # pinned end: the line x = 0 can rotate about y
+    S[[n, top + n], 1:] = True  # roller end: free to move along x
+    P = np.zeros((m.n_nodes, 3))
+    P[[n, top + n], 0] = -0.5  # unit axial compression
+    return m, S, P
+
+
 def von_mises_limit_load(a: float = _VMA, h: float = _VMH, EA: float = _VMEA) -> float:
     """Limit load of the von Mises truss with Green-strain bars (exact for any rise):
     ``P_max = 2 EA h^3 / (3 sqrt(3) L0^3)``, ``L0 = sqrt(a^2 + h^2)``, at apex height

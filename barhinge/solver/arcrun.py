@@ -48,7 +48,12 @@ class ArcDriver(Protocol):
         self, st: State, t1: float, lam1: float
     ) -> tuple[State, Evaluation, list[float]]: ...
     def record(
-        self, st: State, e: Evaluation, iters: int, res: list[float], neg: int | None = None
+        self,
+        st: State,
+        e: Evaluation,
+        iters: int,
+        res: list[float],
+        counts: tuple[int | None, int | None] = (None, None),
     ) -> None: ...
     def path(self, converged: bool = True, message: str = "") -> FoldPath: ...
     def fail(self, step: int, lam: float, why: str, res: list[float]) -> ConvergenceError: ...
@@ -96,7 +101,9 @@ def run_arc_length(d: ArcDriver, progress: Progress | None) -> FoldPath:
         try:
             ctx.factorize(e, st)
             factored = True
+            held = d.system.held_negative_eigenvalues() if ctx.n_act else None
             d.records[-1].neg = d.system.tangent_negative_eigenvalues()
+            d.records[-1].neg_held = held
         except SingularMatrixError:
             factored = False  # the attempt raises its own failure
         if o.arc_stop_instability and _lost_stability(d.records[0].neg, d.records[-1].neg):
@@ -150,7 +157,8 @@ def run_arc_length(d: ArcDriver, progress: Progress | None) -> FoldPath:
         if progress is not None:
             progress(min(max(int(st.lam * steps), 0), steps), steps, st.lam)
     if stop is None or stop["criterion"] != "instability":  # else known, exact, at this state
-        d.records[-1].neg = d.inertia.tangent_inertia(st, e_new if n else e, exact=True)
+        counts = d.inertia.tangent_inertia(st, e_new if n else e, exact=True)
+        d.records[-1].neg, d.records[-1].neg_held = counts
     if stop is None:
         msg = (
             f"arc length stopped at its step cap (max_arc_steps = {max_steps}) at load "

@@ -485,6 +485,33 @@ class BorderedSystem:
             self.negative_pivots = neg() - offset if neg is not None else None
             self.inertia_seen.append(self.negative_pivots)
 
+    def held_negative_eigenvalues(self) -> int | None:
+        """Negative eigenvalues of the free-DOF tangent ``K_t`` with the actuators *held*:
+        of ``Z^T K_t Z``, ``Z`` a basis of the motions that keep every actuator angle
+        (``G Z = 0``), from the last factorisation at no extra cost; None when the backend's
+        factor gives no inertia or no factor is kept. Without actuators: ``K_t``'s count.
+
+        For ``G`` of full row rank ``In(B) = In(Z^T K_t Z) + (n_act, n_act, 0)`` for the
+        bordered matrix ``B = [K_t G^T; G 0]`` (Gould 1985, Math. Prog. 32, Lemma 3.4), so
+        the count is ``neg(B) - n_act``: the saddle-point factorisation gives ``neg(B)``,
+        the Schur route ``neg(A) + neg(-S)`` (``A = K_t + p G^T G``, ``S = G A^-1 G^T``,
+        Haynsworth). Read it before :meth:`tangent_negative_eigenvalues`, which may release
+        the bordered factor."""
+        f, direct = self.factor, self.direct
+        neg = getattr(f, "negative_pivots", None)
+        if neg is None or direct is None:
+            return None
+        n_b = neg()
+        if n_b is None:
+            return None
+        if self.Gf is None:
+            return int(n_b)
+        if isinstance(direct, _DirectSolver):
+            assert direct.S_inv is not None  # kept with actuators
+            S_inv = 0.5 * (direct.S_inv + direct.S_inv.T)  # (G A^-1 G^T)^-1
+            n_b += int(np.sum(np.linalg.eigvalsh(S_inv) > 0))
+        return int(n_b) - self.Gf.shape[0]
+
     def tangent_negative_eigenvalues(self) -> int | None:
         """Negative eigenvalues of the free-DOF tangent ``K_t = K_ff + sum mu_a H_a`` with the
         actuators *released* (their moments held), from the last factorisation; None when

@@ -268,12 +268,17 @@ class _Driver:
 
     # ------------------------------------------------------------ records
     def record(
-        self, st: State, e: Evaluation, iters: int, res: list[float], neg: int | None = None
+        self,
+        st: State,
+        e: Evaluation,
+        iters: int,
+        res: list[float],
+        counts: tuple[int | None, int | None] = (None, None),
     ) -> None:
-        """Append the converged state ``st`` (``neg``: negative eigenvalues of its free-DOF
-        tangent, None if unknown)."""
+        """Append the converged state ``st`` (``counts``: negative eigenvalues of its
+        free-DOF tangent with the actuators released and held, None if unknown)."""
         wall = time.perf_counter() - self.t_start
-        self.records.append(make_record(self.ctx, st, e, iters, res, wall, self.work.work, neg))
+        self.records.append(make_record(self.ctx, st, e, iters, res, wall, self.work.work, *counts))
 
     def path(self, converged: bool = True, message: str = "") -> FoldPath:
         return build_path(
@@ -337,7 +342,7 @@ class _Driver:
         o, timer = self.opts, self.ctx.timer
         steps = self.scene.steps
         st, e = self.initial()
-        self.record(st, e, 0, [], neg=self.inertia.tangent_inertia(st, e, exact=True))
+        self.record(st, e, 0, [], self.inertia.tangent_inertia(st, e, exact=True))
         self._hist.append((st.t, np.concatenate([st.x, st.mu])))
         e_new = e
         h0 = 1.0 / steps
@@ -384,7 +389,7 @@ class _Driver:
                 if self.n_iter_last <= o.grow_iters:
                     h = min(2 * h_try, h0)
             fact1 = timer.n_factorizations
-            neg = self.inertia.state_inertia(st, e_new, self._last_neg())
+            counts = self.inertia.state_inertia(st, e_new, self._last_counts())
             self.step_stats.append(
                 StepStats(
                     iterations=iters,
@@ -394,14 +399,18 @@ class _Driver:
                     inertia_factorizations=timer.n_factorizations - fact1,
                 )
             )
-            self.record(st, e_new, iters, res_all, neg=neg)
+            self.record(st, e_new, iters, res_all, counts)
             if progress is not None:
                 progress(s, steps, st.t)
         return self.path()
 
-    def _last_neg(self) -> int | None:
-        """Negative eigenvalues of the last recorded state where they are known."""
-        return next((r.neg for r in reversed(self.records) if r.neg is not None), None)
+    def _last_counts(self) -> tuple[int | None, int | None]:
+        """Negative eigenvalues (released, held) of the last recorded state where each is
+        known."""
+        known = [(r.neg, r.neg_held) for r in reversed(self.records)]
+        released = next((n for n, _ in known if n is not None), None)
+        held = next((h for _, h in known if h is not None), None)
+        return released, held
 
     def _retry(self, st: State) -> bool:
         """Whether a failed increment from ``st`` is retried at the same length with the

@@ -13,7 +13,7 @@ import numpy as np
 
 from barhinge.results import FoldPath
 from barhinge.solver.context import SolveContext
-from barhinge.solver.stability import stability_events
+from barhinge.solver.stability import held_stability_events, stability_events
 from barhinge.solver.state import Evaluation, State, StepRecord, StepStats
 from barhinge.solver.work import work_balance
 
@@ -31,10 +31,11 @@ def make_record(
     wall: float,
     work: float,
     neg: int | None = None,
+    neg_held: int | None = None,
 ) -> StepRecord:
     """The record of the converged state ``st`` (``wall``: seconds since the start,
     ``work``: external work so far, ``neg``: negative eigenvalues of its free-DOF tangent,
-    None if unknown)."""
+    ``neg_held``: the same with the held actuators held; None if unknown)."""
     X = st.x.reshape(-1, 3)
     ev = e.ev
     R = np.zeros(ctx.n_dof)
@@ -56,6 +57,7 @@ def make_record(
         wall=wall,
         work=work,
         neg=neg,
+        neg_held=neg_held,
     )
 
 
@@ -109,6 +111,8 @@ def build_path(
     if imperfection is not None:  # the model is stress-free in a buckling-mode shape
         meta["imperfection"] = imperfection
     meta["negative_eigenvalues"] = [r.neg for r in rec]
+    # the same with the held actuators held (None without held actuators)
+    meta["negative_eigenvalues_held"] = [r.neg_held for r in rec]
     # distance of the actuators from their targets per state, deg (solver tolerance for
     # held actuators; the springs' stretch for compliant ones)
     meta["compliant_actuators"] = ctx.k_act is not None
@@ -116,7 +120,11 @@ def build_path(
         float(np.max(np.abs((np.degrees(r.rho) - r.targets + 180.0) % 360.0 - 180.0), initial=0.0))
         for r in rec
     ]
-    events = meta["branch_events"] + stability_events(rec, scene.control)
+    events = (
+        meta["branch_events"]
+        + stability_events(rec, scene.control)
+        + held_stability_events(rec, scene.control)
+    )
     meta["work_balance"], unbalanced = work_balance(rec, ctx.floor, ctx.size)
     if unbalanced:
         events.append(unbalanced)

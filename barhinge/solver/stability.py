@@ -14,7 +14,7 @@ from barhinge.linalg.backends import SingularMatrixError
 from barhinge.solver.context import SolveContext
 from barhinge.solver.state import Evaluation, IncrementFailed, State, StepRecord
 
-__all__ = ["InertiaMonitor", "left_branch", "stability_events"]
+__all__ = ["InertiaMonitor", "held_stability_events", "left_branch", "stability_events"]
 
 log = logging.getLogger("barhinge.solver.newton")
 
@@ -100,11 +100,15 @@ class InertiaMonitor:
                 )
         return ""
 
-    def tangent_inertia(self, st: State, e: Evaluation, exact: bool) -> int | None:
-        """Negative eigenvalues of the free-DOF tangent at the converged state ``st``
-        (actuators released; :meth:`BorderedSystem.tangent_negative_eigenvalues`).
+    def tangent_inertia(
+        self, st: State, e: Evaluation, exact: bool
+    ) -> tuple[int | None, int | None]:
+        """Negative eigenvalues of the free-DOF tangent at the converged state ``st``:
+        (actuators released, :meth:`BorderedSystem.tangent_negative_eigenvalues`; held
+        actuators held, :meth:`BorderedSystem.held_negative_eigenvalues`, None without held
+        actuators).
 
-        ``exact``: factorise the tangent at ``st`` (one factorisation). Otherwise the count
+        ``exact``: factorise the tangent at ``st`` (one factorisation). Otherwise the counts
         of the last factorisation Newton made since :attr:`inc_serial` (the tangent one
         iterate before convergence), None if there was none."""
         ctx = self.ctx
@@ -115,26 +119,33 @@ class InertiaMonitor:
                 ctx.factorize(e, st)
             except SingularMatrixError as exc:
                 log.debug("tangent at load factor %.6g not factorised: %s", st.lam, exc)
-                return None
+                return None, None
         elif ctx.timer.n_factorizations <= self.inc_serial:
-            return None
-        return ctx.system.tangent_negative_eigenvalues()
+            return None, None
+        # the held count first: the released count may release the bordered factor
+        held = ctx.system.held_negative_eigenvalues() if ctx.n_act else None
+        return ctx.system.tangent_negative_eigenvalues(), held
 
-    def state_inertia(self, st: State, e: Evaluation, prev: int | None) -> int | None:
-        """Inertia of a converged state for its record (option ``stability_check``): exact,
-        or the free count of the increment's last factorisation, confirmed by an exact one
-        when it differs from the previous state's (``prev``, or is unknown). The iterate
-        before convergence can lie on the other side of a soft mode whose eigenvalue is
-        small against the tangent's change over one Newton correction (measured: -0.25
-        against 1.4e5 on a seeded degree-4 vertex), so an unconfirmed change would be a
-        false event; a true change the last iterate did not see is reported one step
-        late."""
+    def state_inertia(
+        self, st: State, e: Evaluation, prev: tuple[int | None, int | None]
+    ) -> tuple[int | None, int | None]:
+        """Inertia of a converged state for its record, (released, held) as
+        :meth:`tangent_inertia` (option ``stability_check``): exact, or the counts of the
+        increment's last factorisation, confirmed by an exact one when either differs from
+        the previous state's (``prev``) or is unknown. The iterate before convergence can
+        lie on the other side of a soft mode whose eigenvalue is small against the
+        tangent's change over one Newton correction (measured: -0.25 against 1.4e5 on a
+        seeded degree-4 vertex), so an unconfirmed change would be a false event; a true
+        change the last iterate did not see is reported one step late."""
         if self.exact:
             return self.tangent_inertia(st, e, exact=True)
-        n = self.tangent_inertia(st, e, exact=False)
-        if n is None or n != prev:
+        n, held = self.tangent_inertia(st, e, exact=False)
+        changed = n is None or n != prev[0]
+        if self.ctx.n_act:
+            changed = changed or held is None or held != prev[1]
+        if changed:
             return self.tangent_inertia(st, e, exact=True)
-        return n
+        return n, held
 
 
 def stability_events(records: Sequence[StepRecord], control: str) -> list[str]:
@@ -168,4 +179,35 @@ def stability_events(records: Sequence[StepRecord], control: str) -> list[str]:
             events.append(
                 f"negative-stiffness branch {what} at {where}, load factor {lam[i]:.6g} ({change})"
             )
+    return events
+
+
+def held_stability_events(records: Sequence[StepRecord], control: str) -> list[str]:
+    """Events where the equilibrium becomes unstable with the held actuators held (the
+    tangent on the motions that keep every actuator angle has a negative eigenvalue: the
+    driven structure itself would leave the state, whatever the actuators' moments), and
+    where it is stable again. The count of the first state enters when it is nonzero."""
+    known = [(i, r.neg_held) for i, r in enumerate(records) if r.neg_held is not None]
+    events = []
+    before = 0
+    for i, n in known:
+        if (n > 0) == (before > 0):
+            before = n
+            continue
+        where = (
+            "at the start"
+            if i == 0
+            else f"at {'state' if control == 'arc_length' else 'step'} {i}, load factor "
+            f"{records[i].lam:.6g}"
+        )
+        change = f"negative eigenvalues of the tangent with the actuators held {before} -> {n}"
+        if n > 0:
+            events.append(
+                f"unstable equilibrium with the actuators held {where} ({change}): the driven "
+                "structure would leave this state, and the path from here follows an unstable "
+                "branch"
+            )
+        else:
+            events.append(f"stable again with the actuators held {where} ({change})")
+        before = n
     return events

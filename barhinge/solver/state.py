@@ -70,6 +70,8 @@ class StepRecord:
     wall: float  # seconds since the start of the solve
     work: float  # external work up to this state
     neg: int | None  # negative eigenvalues of the free-DOF tangent (None: unknown)
+    #: the same with the held actuators held (None: unknown or no held actuators)
+    neg_held: int | None = None
 
 
 @dataclasses.dataclass

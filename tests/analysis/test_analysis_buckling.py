@@ -15,35 +15,7 @@ from barhinge.analysis.buckling import (
 )
 from barhinge.errors import BucklingError
 from barhinge.pattern.crease import CreasePattern
-
-
-def _strip(n: int, ell: float = 1.0, b: float = 0.5, k: float = 2.0, rigid: float = 1e7):
-    """A strip of ``n`` panels ``ell x b`` in a row along x, joined by ``n - 1`` transverse
-    creases of rotational stiffness ``k``; panels (bars and bending) ``rigid``."""
-    xs = ell * np.arange(n + 1)
-    V = np.vstack(
-        [np.column_stack([xs, np.zeros(n + 1)]), np.column_stack([xs, np.full(n + 1, b)])]
-    )
-    bot = lambda i: i  # noqa: E731
-    top = lambda i: n + 1 + i  # noqa: E731
-    edges, asg = [], []
-    for i in range(n):
-        edges += [(bot(i), bot(i + 1)), (top(i), top(i + 1))]
-        asg += ["B", "B"]
-    for i in range(n + 1):
-        edges.append((bot(i), top(i)))
-        asg.append("B" if i in (0, n) else "V")
-    faces = [[bot(i), bot(i + 1), top(i + 1), top(i)] for i in range(n)]
-    cp = CreasePattern(V, edges, asg, faces=faces)
-    m = bh.BarHingeModel.from_pattern(
-        cp, "N4B5", bh.Material(E=1.0, nu=0.3, t=0.01), bar_EA=rigid, bend_k=rigid, fold_k=k
-    )
-    S = np.zeros((m.n_nodes, 3), bool)
-    S[[bot(0), top(0)]] = True  # pinned end: the line x = 0 can rotate about y
-    S[[bot(n), top(n)], 1:] = True  # roller end: free to move along x
-    P = np.zeros((m.n_nodes, 3))
-    P[[bot(n), top(n)], 0] = -0.5  # unit axial compression
-    return m, S, P
+from barhinge.verify import rigid_link_strut
 
 
 def test_stiffness_parts_sum_to_the_tangent():
@@ -68,7 +40,7 @@ def test_strut_of_rigid_links_buckles_at_the_closed_form(n):
     whose sine modes diagonalise the second difference; Euler's ``pi^2 k l / L^2`` as
     n -> oo). Panels 1e7 x stiffer than the creases: the links are rigid to ~1e-6."""
     ell, k = 1.0, 2.0
-    m, S, P = _strip(n, ell=ell, k=k)
+    m, S, P = rigid_link_strut(n, ell=ell, k=k)
     res = linear_buckling(m, P, S, n_modes=3)
     j = np.arange(1, min(3, n - 1) + 1)
     expect = 4 * k / ell * np.sin(j * np.pi / (2 * n)) ** 2
@@ -89,7 +61,7 @@ def test_arc_length_stops_where_the_strut_bifurcates(monkeypatch):
     from barhinge.scene import Scene
 
     n, ell, k = 5, 1.0, 2.0
-    m, S, P = _strip(n, ell=ell, k=k)
+    m, S, P = rigid_link_strut(n, ell=ell, k=k)
     p1 = 4 * k / ell * np.sin(np.pi / (2 * n)) ** 2
     opts = {"arc_stop_instability": True, "arc_stop_load_factor": 3.0, "max_arc_steps": 200}
     path = bh.solve(Scene(m, supports=S, loads=P, control="arc_length", steps=20, options=opts))
@@ -117,7 +89,7 @@ def test_critical_ahead_of_the_last_stable_states_of_the_strut(monkeypatch):
     from barhinge.scene import Scene
 
     n, ell, k = 5, 1.0, 2.0
-    m, S, P = _strip(n, ell=ell, k=k)
+    m, S, P = rigid_link_strut(n, ell=ell, k=k)
     p1 = 4 * k / ell * np.sin(np.pi / (2 * n)) ** 2
     opts = {"arc_stop_instability": True, "arc_stop_load_factor": 3.0, "max_arc_steps": 200}
     path = bh.solve(Scene(m, supports=S, loads=P, control="arc_length", steps=20, options=opts))
@@ -142,7 +114,7 @@ def test_critical_ahead_of_the_last_stable_states_of_the_strut(monkeypatch):
 def test_critical_between_two_stable_states_is_a_named_error():
     from barhinge.scene import Scene
 
-    m, S, P = _strip(5)
+    m, S, P = rigid_link_strut(5)
     path = bh.solve(Scene(m, supports=S, loads=0.5 * P, control="load", steps=2))
     X = np.asarray(path.X)  # below the critical load 0.764: both states stable
     with pytest.raises(BucklingError, match="no loss of stability between the two states"):
@@ -196,13 +168,13 @@ def test_refined_plate_buckles_at_the_closed_form():
 
 
 def test_tension_only_has_no_buckling_factor():
-    m, S, P = _strip(3)
+    m, S, P = rigid_link_strut(3)
     with pytest.raises(BucklingError, match="nothing in compression"):
         linear_buckling(m, -P, S)
 
 
 def test_mechanism_is_a_named_error():
-    m, S, P = _strip(3)
+    m, S, P = rigid_link_strut(3)
     S[:] = False
     S[0] = True
     with pytest.raises(BucklingError, match="singular|mechanism"):
@@ -214,7 +186,7 @@ def test_modes_are_written_as_vtu(tmp_path):
 
     from barhinge.output.modes import write_mode_vtus
 
-    m, S, P = _strip(3)
+    m, S, P = rigid_link_strut(3)
     res = linear_buckling(m, P, S, n_modes=2)
     paths = write_mode_vtus(tmp_path, m, res.X, res.modes, res.factors)
     assert [p.name for p in paths] == ["buckling_mode_1.vtu", "buckling_mode_2.vtu"]

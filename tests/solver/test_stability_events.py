@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import scipy.linalg
 import scipy.sparse as sp
 
 import barhinge as bh
@@ -33,7 +34,7 @@ from barhinge.scene import Scene
 from barhinge.solver import newton
 from barhinge.solver.bordered import BorderedSystem, Timer, actuator_terms
 from barhinge.solver_options import SolverOptions
-from barhinge.verify import von_mises_limit_load, von_mises_model
+from barhinge.verify import rigid_link_strut, von_mises_limit_load, von_mises_model
 
 H_VM = 0.3  # rise of barhinge.verify's von Mises truss
 P_MAX = von_mises_limit_load()
@@ -53,7 +54,8 @@ def _vm_scene(steps: int = 20, factor: float = 1.5, **opts) -> Scene:
 def test_released_inertia_from_the_bordered_factorisation_matches_dense(name, route, monkeypatch):
     """neg(K_t) = neg([K_t G^T; G 0]) - neg(Y), Y the multiplier block of the inverse
     (Haynsworth), or (many actuators) the pivots of a factorisation of K_t itself: both
-    checked on a Miura tangent shifted to 0, 3, 7 and 11 negative eigenvalues."""
+    checked on a Miura tangent shifted to 0, 3, 7 and 11 negative eigenvalues; and the held
+    count neg([K_t G^T; G 0]) - n_act against the eigenvalues of ``Z^T K_t Z`` (G Z = 0)."""
     from barhinge.solver import bordered
 
     min_act = 1 if route == "released factor" else 10**9
@@ -72,16 +74,51 @@ def test_released_inertia_from_the_bordered_factorisation_matches_dense(name, ro
         Kt[np.ix_(dofs, dofs)] += mu[a] * terms.hess[a]
     w = np.linalg.eigvalsh(Kt[np.ix_(free, free)])
     n0 = int(np.sum(w < 0))  # the perturbed tangent is indefinite already (7)
+    # held actuators: the tangent on the motions that keep every actuator angle
+    Z = scipy.linalg.null_space(terms.G[:, free].toarray())
+    Ktf = Kt[np.ix_(free, free)]
     for n_neg in (0, 3, n0, n0 + 4):
         shift = w[0] - 1.0 if n_neg == 0 else 0.5 * (w[n_neg - 1] + w[n_neg])
         sysm = BorderedSystem(get_backend(name), free, terms.dofs, Timer())
         sysm.factorize((K - shift * sp.identity(K.shape[0])).tocsr(), terms, mu, penalty=50.0)
+        held = np.linalg.eigvalsh(Z.T @ (Ktf - shift * np.eye(len(Ktf))) @ Z)
+        assert sysm.held_negative_eigenvalues() == int(np.sum(held < 0)), (name, n_neg)
         got = sysm.tangent_negative_eigenvalues()
         assert got == int(np.sum(w < shift)) == n_neg, (name, n_neg, got)
         # the bordered (saddle-point) factorisation takes the released factor's route
         took = sysm._released_counter is not None
         saddle = getattr(sysm.backend, "saddle_point", False)
         assert took == (route == "released factor" and saddle), name
+
+
+@pytest.mark.parametrize("name", available_backends())
+def test_held_and_released_counts_of_a_driven_strut_follow_the_closed_forms(name):
+    """A pinned-pinned chain of three rigid links (length l = 1, rotational springs k = 2 at
+    the two inner creases) under an axial load ramped to 4.4 over 10 steps, its first
+    inner crease driven (held at 0 deg). Released, it is the three-link strut: critical
+    load ``4 k / l sin^2(pi / 6) = 2`` (Bazant & Cedolin 1991, ch. 1); held, the driven
+    crease joins the first two links into one of length 2 l, and the two-link strut with
+    one spring buckles at ``k (1 / (2 l) + 1 / l) = 3`` (its energy
+    ``k/2 (w/a + w/b)^2 - P/2 (w^2/a + w^2/b)``). Both counts change at the first step past
+    their critical load (2.2 and 3.08), and the held change is an event."""
+    model, S, P = rigid_link_strut(3, ell=1.0, k=2.0)
+    crease = next(i for i, e in enumerate(model.pattern.edges) if set(e) == {1, 5})
+    scene = Scene(
+        model,
+        supports=S,
+        loads=4.4 * P,
+        actuators=bh.Actuators(edges=[crease], targets_deg=[0.0]),
+        steps=10,
+        control="fold_angle",
+        options={"linear_solver": name},
+    )
+    path = bh.solve(scene)
+    load = 4.4 * path.load_factor
+    released, held = path.meta["negative_eigenvalues"], path.meta["negative_eigenvalues_held"]
+    assert released == [int(p > 2.0) for p in load]
+    assert held == [int(p > 3.0) for p in load]
+    unstable = [e for e in path.meta["events"] if e.startswith("unstable equilibrium")]
+    assert len(unstable) == 1 and "at step 7" in unstable[0], path.meta["events"]
 
 
 @pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO releases factors")
