@@ -220,7 +220,11 @@ class BorderedSystem:
         self._blk_pos: np.ndarray | None = None  # positions of actuator blocks in K.data
         self._blk_ok = False
         self.factor: Any = None
+        #: load and displacement control: an increment whose held counts change fails
         self.track_inertia = False
+        #: negative eigenvalues of the last factorised tangent with the actuators held
+        #: (:meth:`held_negative_eigenvalues`), and of every factorisation since the driver
+        #: last emptied the list
         self.negative_pivots: int | None = None
         self.inertia_seen: list[int | None] = []
         # current operator (exact tangent of the current iterate)
@@ -451,7 +455,6 @@ class BorderedSystem:
         self.factor = self.backend.factorize(self.A)
         self.timer.factorize += time.perf_counter() - t_start
         self.timer.n_factorizations += 1
-        self._record_inertia(0)
         Z = S_inv = None
         if self.Gf is not None:
             t0 = time.perf_counter()
@@ -476,14 +479,6 @@ class BorderedSystem:
                     "actuators are redundant or fixed by supports"
                 )
         self._keep(_DirectSolver(self.factor, self.Gf, Z, S_inv, self.penalty), t_start)
-
-    def _record_inertia(self, offset: int) -> None:
-        """Negative eigenvalues of the free-DOF tangent from the factor's pivots (minus
-        ``offset`` for a bordered matrix), when the control tracks them."""
-        if self.track_inertia:
-            neg = getattr(self.factor, "negative_pivots", None)
-            self.negative_pivots = neg() - offset if neg is not None else None
-            self.inertia_seen.append(self.negative_pivots)
 
     def held_negative_eigenvalues(self) -> int | None:
         """Negative eigenvalues of the free-DOF tangent ``K_t`` with the actuators *held*:
@@ -554,13 +549,16 @@ class BorderedSystem:
         self.current_factored = True
         self._fact_cost = time.perf_counter() - t_start
         self._krylov_cost = 0.0
+        # the held count of every factorisation (free): load and displacement control check
+        # it inside an increment, and a failed increment names it
+        self.negative_pivots = self.held_negative_eigenvalues()
+        self.inertia_seen.append(self.negative_pivots)
 
     def _factorize_kkt(self, t_start: float) -> bool:
         """One symmetric indefinite factorisation of the whole bordered matrix (backends
         with ``saddle_point``): no Schur complement, no ``n_act`` solves per iteration.
         Returns False (nothing kept) when the factorisation had to perturb pivots."""
         assert self.Gf is not None  # called with actuators only
-        na = self.Gf.shape[0]
         # saddle-point backends take the upper triangle (``upper``)
         factorize: Any = self.backend.factorize
         self.factor = factorize(self._kkt_matrix(upper=True), upper=True)
@@ -569,7 +567,6 @@ class BorderedSystem:
         perturbed = getattr(self.factor, "perturbed_pivots", None)
         if perturbed is not None and perturbed() > 0:
             return False
-        self._record_inertia(na)  # inertia(KKT) = inertia(A) + inertia(-S), S > 0 when A > 0
         self._keep(_KKTSolver(self.factor, self.Gf, self.penalty), t_start)
         self._released = None
         if self._blk_ok and self._penalty_blocks is not None and self._values is not None:

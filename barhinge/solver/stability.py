@@ -85,7 +85,8 @@ class InertiaMonitor:
             )
 
     def failure_text(self, why: str) -> str:
-        """The critical point a failed increment met while iterating ("" if none)."""
+        """The critical point a failed increment met while iterating ("" if none); under
+        fold-angle control the instability of the driven structure its iterates met."""
         sysm = self.ctx.system
         if why.startswith(self.critical):
             return why
@@ -98,6 +99,14 @@ class InertiaMonitor:
                     f"{self.inertia} to {bad[0]} while iterating ({why}); use "
                     "control = 'arc_length' to pass it"
                 )
+        unstable = [n for n in sysm.inertia_seen if n]
+        if self.ctx.n_act and not sysm.track_inertia and self.inertia == 0 and unstable:
+            # fold-angle control from a stable state: say what the iterates met
+            return (
+                f"{why}; the iterates' tangent was unstable with the actuators held (up to "
+                f"{max(unstable)} negative eigenvalues): the driven structure is near an "
+                "instability there"
+            )
         return ""
 
     def tangent_inertia(

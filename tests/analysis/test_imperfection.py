@@ -12,15 +12,14 @@ from barhinge.analysis.imperfection import imperfect
 from barhinge.errors import ConfigError
 from barhinge.scene import Scene
 from barhinge.solver_options import SolverOptions
-
-from .test_analysis_buckling import _strip
+from barhinge.verify import rigid_link_strut
 
 
 def _strut_deflection(a: float, alpha: float) -> tuple[float, float]:
     """Lateral deflection, beyond the imperfection, of the node of largest mode amplitude of a
     5-link strut with a first-mode imperfection of amplitude ``a`` under ``alpha P_1``;
     and the closed form ``a alpha / (1 - alpha)``."""
-    m, S, P = _strip(5)
+    m, S, P = rigid_link_strut(5)
     res = linear_buckling(m, P, S, n_modes=1)
     p1, phi = float(res.factors[0]), res.modes[0]
     mi = imperfect(m, phi, a, loads=P)
@@ -33,7 +32,7 @@ def _strut_deflection(a: float, alpha: float) -> tuple[float, float]:
 
 
 def test_imperfect_model_is_stress_free_at_its_reference():
-    m, S, P = _strip(5)
+    m, S, P = rigid_link_strut(5)
     phi = linear_buckling(m, P, S, n_modes=1).modes[0]
     mi = imperfect(m, phi, 0.05)
     moved = np.linalg.norm(mi.X0 - m.X0, axis=1)
@@ -62,7 +61,7 @@ def test_strut_amplifies_its_imperfection_by_the_closed_form(alpha):
 
 
 def test_imperfection_sign_follows_the_loads():
-    m, S, P = _strip(5)
+    m, S, P = rigid_link_strut(5)
     phi = linear_buckling(m, P, S, n_modes=1).modes[0]
     down = np.zeros_like(P)
     down[:, 2] = -1.0
@@ -82,7 +81,7 @@ def test_imperfection_sign_follows_the_loads():
     ],
 )
 def test_bad_imperfections_are_named(shape, amplitude, match):
-    m, _, _ = _strip(3)
+    m, _, _ = rigid_link_strut(3)
     s = np.ones((m.n_nodes, 3))
     if isinstance(shape, np.ndarray):
         s = shape
@@ -103,7 +102,7 @@ def test_soft_mode_of_the_imperfect_strut_converges_to_the_displacement_toleranc
     is confirmed by a back-substitution of the final residual; before that check the
     10-step run ended 3 tolerances off with the quadratic predictor and 360 with the
     polynomial one)."""
-    m, S, P = _strip(5)
+    m, S, P = rigid_link_strut(5)
     res = linear_buckling(m, P, S, n_modes=1)
     mi = imperfect(m, res.modes[0], 1e-3, loads=P)
     ends = []
@@ -122,7 +121,7 @@ def test_soft_mode_of_the_imperfect_strut_converges_under_arc_length():
     agree within a few tol_disp * size. (The arc-length corrector confirms a state accepted
     by the residual's rate with its next correction, the arc constraint kept; this strut
     passed before that check as well: it guards the arc path, it does not show the fix.)"""
-    m, S, P = _strip(5)
+    m, S, P = rigid_link_strut(5)
     res = linear_buckling(m, P, S, n_modes=1)
     mi = imperfect(m, res.modes[0], 1e-3, loads=P)
     ends = []

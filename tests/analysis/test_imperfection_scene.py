@@ -16,8 +16,7 @@ from barhinge.analysis.imperfection import amplitude_length, seed_imperfection, 
 from barhinge.cli import app
 from barhinge.errors import ConfigError
 from barhinge.scene import Imperfection, Scene, load_scene, scene_from_dict
-
-from .test_analysis_buckling import _strip
+from barhinge.verify import rigid_link_strut
 
 ROOF = """
 name = "roof-imperfect"
@@ -53,7 +52,7 @@ def test_span_of_a_strut_is_its_length_and_of_a_cantilever_twice_it():
     """Twice the largest plan distance to the nearest support: a 4-link strut held at both
     ends spans its length 4; held at one end only it is a cantilever of length 4, whose
     span (effective length of a bow) is 8."""
-    m, S, _ = _strip(4)
+    m, S, _ = rigid_link_strut(4)
     assert span(m.X0, S) == pytest.approx(4.0, rel=1e-12)
     one_end = S.copy()
     one_end[[4, 9]] = False  # release the roller end (nodes x = 4)
@@ -66,7 +65,7 @@ def test_seeded_strut_scene_amplifies_by_the_closed_form(alpha):
     column's amplification ``a alpha / (1 - alpha)`` (Timoshenko & Gere 1961, sec. 1.12) for
     a first-mode imperfection of amplitude ``a = 1e-3 l``, to the O(a / l) of the linearised
     closed form (tests/analysis/test_imperfection.py)."""
-    m, S, P = _strip(5)
+    m, S, P = rigid_link_strut(5)
     p1 = float(linear_buckling(m, P, S, n_modes=1).factors[0])
     a = 1e-3
     scene = Scene(m, supports=S, loads=alpha * p1 * P, control="load", steps=10,
@@ -88,7 +87,7 @@ def test_second_mode_is_the_second_buckling_mode():
     """mode = 2 seeds the strut's second mode: its factor is the second buckling factor and
     the shape is antisymmetric about mid-span (a pinned strut's second mode has a node
     there)."""
-    m, S, P = _strip(4)
+    m, S, P = rigid_link_strut(4)
     b = linear_buckling(m, P, S, n_modes=2)
     wanted = Imperfection(mode=2, amplitude=0.01)
     seeded = seed_imperfection(Scene(m, supports=S, loads=P, control="load", imperfection=wanted))
@@ -100,7 +99,7 @@ def test_second_mode_is_the_second_buckling_mode():
 
 
 def test_the_solver_refuses_a_scene_whose_imperfection_is_not_applied():
-    m, S, P = _strip(3)
+    m, S, P = rigid_link_strut(3)
     scene = Scene(m, supports=S, loads=P, control="load",
                   imperfection=Imperfection(amplitude=0.01))  # fmt: skip
     with pytest.raises(ConfigError, match="seed_imperfection"):
@@ -184,7 +183,7 @@ def test_span_needs_real_supports_and_a_length_needs_no_rule():
     used as given, and the summary line names no rule for it."""
     from barhinge.output.summary import imperfection_text
 
-    m, _, P = _strip(3)
+    m, _, P = rigid_link_strut(3)
     free = Scene(m, loads=P, control="load", imperfection=Imperfection(amplitude="span/300"))
     assert free.auto_restrained
     with pytest.raises(ConfigError, match="span/N' needs supports"):

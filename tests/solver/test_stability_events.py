@@ -121,6 +121,24 @@ def test_held_and_released_counts_of_a_driven_strut_follow_the_closed_forms(name
     assert len(unstable) == 1 and "at step 7" in unstable[0], path.meta["events"]
 
 
+def test_failed_fold_increment_names_the_instability_its_iterates_met():
+    """A fold-angle increment that fails from a stable state after iterates whose tangent
+    is unstable with the actuators held says so in its reason (the counts come with every
+    factorisation); with no such iterate the reason stays as it was."""
+    model, S, P = rigid_link_strut(3)
+    crease = next(i for i, e in enumerate(model.pattern.edges) if set(e) == {1, 5})
+    acts = bh.Actuators(edges=[crease], targets_deg=[0.0])
+    scene = Scene(model, supports=S, loads=P, actuators=acts)
+    d = newton._Driver(scene)
+    d.inertia.inertia = 0
+    d.system.inertia_seen = [0, 2, 1]
+    text = d.inertia.failure_text("residual diverged")
+    assert text.startswith("residual diverged; the iterates' tangent was unstable with the")
+    assert "up to 2 negative eigenvalues" in text
+    d.system.inertia_seen = [0, 0]
+    assert d.inertia.failure_text("residual diverged") == ""
+
+
 @pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO releases factors")
 def test_released_bordered_factor_gives_the_same_fold(monkeypatch):
     """Above ``InertiaCounter.RELEASE_ABOVE`` the bordered factor is released before the
