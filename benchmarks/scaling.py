@@ -117,6 +117,12 @@ def one(n: int, steps: int, material: str) -> dict:
         "share_assembly": tm["assembly"] / solver_wall,
         "peak_mb": _peak_mb(),
         "steps": steps,
+        # steps whose equilibrium no actuator holds (docs/solver.md, *Stability events*)
+        "held_unstable": [
+            i
+            for i, c in enumerate(path.meta["negative_eigenvalues_held"])
+            if c is not None and c > 0
+        ],
     }
 
 
@@ -272,8 +278,8 @@ def fold_table(rows: list[dict], steps: int) -> list[str]:
         "the stability events) | floor: one "
         "refactorisation per step, s | fold wall s | wall / floor | s / iteration | shares: "
         "factorisation / assembly / rest | fold CPU s | whole process: wall s / CPU s / max "
-        "RSS MB | KB / DOF |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "RSS MB | KB / DOF | steps unstable with the actuators held |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         rest = 1.0 - r["share_factorize"] - r["share_assembly"]
@@ -285,9 +291,25 @@ def fold_table(rows: list[dict], steps: int) -> list[str]:
             f"| {r['share_factorize']:.0%} / {r['share_assembly']:.0%} / {rest:.0%} "
             f"| {r['cpu']:.1f} | {_fmt(r, 'process_wall', '.1f')} / "
             f"{_fmt(r, 'process_cpu', '.1f')} / {_fmt(r, 'process_peak_mb', '.0f')} "
-            f"| {1024 * r.get('process_peak_mb', r['peak_mb']) / r['dof']:.1f} |"
+            f"| {1024 * r.get('process_peak_mb', r['peak_mb']) / r['dof']:.1f} "
+            f"| {_steps(r.get('held_unstable'))} |"
         )
     return lines
+
+
+def _steps(steps: list[int] | None) -> str:
+    """Step numbers as runs ("1-3, 8"); "none" for an empty list, "-" when not measured."""
+    if steps is None:
+        return "-"
+    if not steps:
+        return "none"
+    runs: list[list[int]] = []
+    for i in steps:
+        if runs and i == runs[-1][-1] + 1:
+            runs[-1].append(i)
+        else:
+            runs.append([i])
+    return ", ".join(f"{r[0]}" if len(r) == 1 else f"{r[0]}-{r[-1]}" for r in runs)
 
 
 def stability_lines(rows: list[dict]) -> list[str]:
@@ -314,6 +336,32 @@ def stability_lines(rows: list[dict]) -> list[str]:
         "Newton's, so a fold that reports them takes at least twice its floor:",
         "",
         *out,
+    ]
+
+
+def held_lines(rows: list[dict]) -> list[str]:
+    """Which folds pass through equilibria that no actuator holds (the event ``unstable
+    equilibrium with the actuators held``, docs/solver.md, *Stability events*)."""
+    bad = [r for r in rows if r.get("held_unstable")]
+    if not bad:
+        return []
+    out = [
+        f"n = {r['n']} ({r['material']}): step(s) {_steps(r['held_unstable'])} of "
+        f"{r['steps']} ({60.0 * r['held_unstable'][0] / r['steps']:.1f}"
+        + (
+            f"-{60.0 * r['held_unstable'][-1] / r['steps']:.1f} deg)"
+            if len(r["held_unstable"]) > 1
+            else " deg)"
+        )
+        for r in bad
+    ]
+    return [
+        "",
+        "Equilibria no actuator holds: the fold from flat driven by one line of creases "
+        "converges, on the larger sheets, to states whose tangent with the actuators held has "
+        "negative eigenvalues (a real sheet would leave them; the fold reports the event): "
+        + "; ".join(out)
+        + ". The table times these folds as they run; the states are flagged, not avoided.",
     ]
 
 
@@ -528,7 +576,8 @@ def main() -> None:
             rows.append(row)
             _keep_row(a.rows, kept, key, row)
             print(fold_table(rows, a.steps)[-1], flush=True)
-    lines = fold_table(rows, a.steps) + stability_lines(rows) + exponent_lines(rows)
+    lines = fold_table(rows, a.steps) + held_lines(rows) + stability_lines(rows)
+    lines += exponent_lines(rows)
     lines += [f"\n**Not completed**: {f}" for f in failed]
     for n in a.pieces:
         big = _child(["--one-pieces", str(n)])

@@ -41,7 +41,12 @@ import numpy as np
 
 import barhinge as bh
 from barhinge.errors import ConvergenceError
-from barhinge.verify import degree4_pattern, von_mises_limit_load, von_mises_model
+from barhinge.verify import (
+    degree4_pattern,
+    rigid_link_strut,
+    von_mises_limit_load,
+    von_mises_model,
+)
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
@@ -482,6 +487,34 @@ def barhinge_near_flat() -> Outcome:
     )
 
 
+# ---------------------------------------------------------------- driven instability
+def driven_strut() -> Outcome:
+    """Three rigid links on two crease springs k (l = 1, k = 2), pinned at both ends, the
+    first inner crease driven and held at 0 deg while the axial load grows to 4.4: held,
+    the strut buckles at ``3 k / (2 l) = 3`` (the held crease joins two links), so the
+    fold-angle path converges to states no actuator can hold from the first step past it
+    (step 7, load 3.08); the run must report that, not only the released count's change
+    at ``2 k / l = 2``."""
+    model, S, P = rigid_link_strut(3, ell=1.0, k=2.0)
+    crease = next(i for i, e in enumerate(model.pattern.edges) if set(e) == {1, 5})
+    acts = bh.Actuators(edges=[crease], targets_deg=[0.0])
+    scene = bh.Scene(model, supports=S, loads=4.4 * P, actuators=acts, steps=10)
+    path, out = _solve(scene)
+    if out:
+        return out
+    held = [e for e in path.meta["events"] if e.startswith("unstable equilibrium")]
+    if not held:
+        return Outcome("failed", "the held instability was not reported", _events(path))
+    first = path.meta["negative_eigenvalues_held"].index(1)
+    load = 4.4 * float(path.load_factor[first])
+    return Outcome(
+        "bifurcation",
+        f"unstable with the actuator held from load {load:.2f} (closed form: past 3)",
+        held[0],
+        value=load / 3.0,
+    )
+
+
 # --------------------------------------------------------------------------- table
 SCENARIOS: list[Scenario] = [
     Scenario("snap-load", "load control", "snap-through (limit point)", "failed", snap_load, True),
@@ -563,6 +596,14 @@ SCENARIOS: list[Scenario] = [
         "10 -> 150 deg in 1 step, cut-backs",
         "converged",
         lambda: large_step(8),
+    ),  # fmt: skip
+    Scenario(
+        "driven-strut",
+        "fold-angle control",
+        "driven strut loaded past the buckling load of its held structure",
+        "bifurcation",
+        driven_strut,
+        True,
     ),  # fmt: skip
     Scenario("soft-folds", "fold-angle control", "k_fold = 0 (Miura 2x2)", "converged", soft_folds),
     Scenario(

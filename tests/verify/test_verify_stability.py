@@ -58,6 +58,15 @@ def test_named_causes(study):
     assert cause["snapback-disp"].startswith("snap-back")
     assert cause["rigid-lock"].startswith("lock")
     assert cause["large-step"].startswith("step too large")
+    assert cause["driven-strut"].startswith("unstable with the actuator held")
+
+
+def test_driven_instability_found_at_the_closed_form(study):
+    """The driven strut (its crease held) is unstable past ``3 k / (2 l)``: the event names
+    the first step past it (load 3.08 of 3, steps of 0.44)."""
+    rec = {r["id"]: r for r in study.RECORDS}["driven-strut"]
+    assert 1.0 < rec["value"] <= 1.0 + 0.44 / 3.0, rec
+    assert rec["message"].startswith("unstable equilibrium with the actuators held at step 7")
 
 
 def test_limit_load_checked_against_closed_form(study):
