@@ -366,7 +366,8 @@ class _Driver:
                     )
                     n_failed += 1
                     self._hard_last = True
-                    critical = self.inertia.failure_text(f.why) or critical
+                    held = self._last_counts()[1]
+                    critical = self.inertia.failure_text(f.why, held) or critical
                     if self._retry(st):
                         continue
                     self._retry_tangent = False

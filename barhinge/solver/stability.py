@@ -84,9 +84,11 @@ class InertiaMonitor:
                 res,
             )
 
-    def failure_text(self, why: str) -> str:
+    def failure_text(self, why: str, held_before: int | None = None) -> str:
         """The critical point a failed increment met while iterating ("" if none); under
-        fold-angle control the instability of the driven structure its iterates met."""
+        fold-angle control the instability of the driven structure its iterates met, when
+        the state it started from was stable with the actuators held (``held_before``
+        negative eigenvalues: 0)."""
         sysm = self.ctx.system
         if why.startswith(self.critical):
             return why
@@ -100,12 +102,11 @@ class InertiaMonitor:
                     "control = 'arc_length' to pass it"
                 )
         unstable = [n for n in sysm.inertia_seen if n]
-        if self.ctx.n_act and not sysm.track_inertia and self.inertia == 0 and unstable:
+        if self.ctx.n_act and not sysm.track_inertia and held_before == 0 and unstable:
             # fold-angle control from a stable state: say what the iterates met
             return (
                 f"{why}; the iterates' tangent was unstable with the actuators held (up to "
-                f"{max(unstable)} negative eigenvalues): the driven structure is near an "
-                "instability there"
+                f"{max(unstable)} negative eigenvalues): Newton met states no actuator can hold"
             )
         return ""
 
