@@ -357,8 +357,8 @@ def held_lines(rows: list[dict]) -> list[str]:
     ]
     return [
         "",
-        "Equilibria no actuator holds: the fold from flat driven by one line of creases "
-        "converges, on the larger sheets, to states whose tangent with the actuators held has "
+        "Equilibria no actuator holds: at these steps the fold from flat, driven by one "
+        "line of creases, converges to states whose tangent with the actuators held has "
         "negative eigenvalues (a real sheet would leave them; the fold reports the event): "
         + "; ".join(out)
         + ". The table times these folds as they run; the states are flagged, not avoided.",
