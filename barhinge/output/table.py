@@ -38,6 +38,8 @@ COLUMNS: tuple[str, ...] = (
     "max_abs_bar_strain",
     "max_abs_angle_defect_deg",
     "K_global",
+    "negative_eigenvalues",
+    "negative_eigenvalues_held",
 )
 
 
@@ -95,6 +97,9 @@ def step_table(
         "max_abs_bar_strain": nan.copy(),
         "max_abs_angle_defect_deg": nan.copy(),
         "K_global": nan.copy(),
+        # the stability counts of the states (docs/solver.md, "Stability events")
+        "negative_eigenvalues": _counts(fold_path.meta.get("negative_eigenvalues"), n),
+        "negative_eigenvalues_held": _counts(fold_path.meta.get("negative_eigenvalues_held"), n),
     }
     if model is not None or cp is not None:
         for s in range(n):
@@ -120,10 +125,23 @@ def step_table(
         cols[f"actuator_{int(e)}_target_deg"] = np.asarray(fold_path.actuator_targets_deg)[:, a]
         cols[f"actuator_{int(e)}_fold_deg"] = fold_path.fold_angles_deg[:, e]
         cols[f"actuator_{int(e)}_moment"] = np.asarray(fold_path.actuator_moments)[:, a]
-    ints = ("state", "iterations")
+    ints = ("state", "iterations", "negative_eigenvalues", "negative_eigenvalues_held")
     return [
-        {k: (int(v[s]) if k in ints else float(v[s])) for k, v in cols.items()} for s in range(n)
+        {
+            k: (int(v[s]) if k in ints and np.isfinite(v[s]) else float(v[s]))
+            for k, v in cols.items()
+        }
+        for s in range(n)
     ]
+
+
+def _counts(values: list[int | None] | None, n: int) -> np.ndarray:
+    """(n,) per-state counts as floats, NaN where unknown (or not recorded)."""
+    out = np.full(n, np.nan)
+    for i, c in enumerate((values or [])[:n]):
+        if c is not None:
+            out[i] = c
+    return out
 
 
 def write_step_table(path: str | Path, rows: list[dict[str, float]]) -> Path:

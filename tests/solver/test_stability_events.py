@@ -30,6 +30,7 @@ from barhinge.errors import ConfigError, ConvergenceError
 from barhinge.families import miura_line_creases
 from barhinge.linalg.backends import available_backends, get_backend
 from barhinge.model.model import BarHingeModel
+from barhinge.output.table import step_table
 from barhinge.scene import Scene
 from barhinge.solver import newton
 from barhinge.solver.bordered import BorderedSystem, Timer, actuator_terms
@@ -119,6 +120,9 @@ def test_held_and_released_counts_of_a_driven_strut_follow_the_closed_forms(name
     assert held == [int(p > 3.0) for p in load]
     unstable = [e for e in path.meta["events"] if e.startswith("unstable equilibrium")]
     assert len(unstable) == 1 and "at step 7" in unstable[0], path.meta["events"]
+    rows = step_table(path)  # states.csv has both counts per state
+    assert [r["negative_eigenvalues"] for r in rows] == released
+    assert [r["negative_eigenvalues_held"] for r in rows] == held
 
 
 def test_failed_fold_increment_names_the_instability_its_iterates_met():
