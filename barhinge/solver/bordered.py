@@ -492,20 +492,28 @@ class BorderedSystem:
         the Schur route ``neg(A) + neg(-S)`` (``A = K_t + p G^T G``, ``S = G A^-1 G^T``,
         Haynsworth). Read it before :meth:`tangent_negative_eigenvalues`, which may release
         the bordered factor."""
-        f, direct = self.factor, self.direct
-        neg = getattr(f, "negative_pivots", None)
+        n_b = self._bordered_negative_pivots()
+        if n_b is None or self.Gf is None:
+            return n_b
+        return n_b - self.Gf.shape[0]
+
+    def _bordered_negative_pivots(self) -> int | None:
+        """``neg(B)`` of the bordered matrix ``B = [K_t G^T; G 0]`` from the last
+        factorisation (``neg(K_t)`` without actuators): the saddle-point factor's pivots, or
+        on the Schur route those of ``A = K_t + p G^T G`` plus ``neg(-S) = pos(S^-1)``; None
+        when the factor gives no inertia or none is kept."""
+        direct = self.direct
+        neg = getattr(self.factor, "negative_pivots", None)
         if neg is None or direct is None:
             return None
         n_b = neg()
         if n_b is None:
             return None
-        if self.Gf is None:
-            return int(n_b)
-        if isinstance(direct, _DirectSolver):
+        if self.Gf is not None and isinstance(direct, _DirectSolver):
             assert direct.S_inv is not None  # kept with actuators
             S_inv = 0.5 * (direct.S_inv + direct.S_inv.T)  # (G A^-1 G^T)^-1
             n_b += int(np.sum(np.linalg.eigvalsh(S_inv) > 0))
-        return int(n_b) - self.Gf.shape[0]
+        return int(n_b)
 
     def tangent_negative_eigenvalues(self) -> int | None:
         """Negative eigenvalues of the free-DOF tangent ``K_t = K_ff + sum mu_a H_a`` with the
@@ -519,15 +527,11 @@ class BorderedSystem:
         ``In(B) = In(K_t) + In(Y)`` with ``Y = -(G K_t^-1 G^T)^-1``, the multiplier block of
         ``B^-1``: ``n_act`` solves with the factorisation at hand (valid while K_t is
         nonsingular, i.e. away from the critical point itself)."""
-        f, direct = self.factor, self.direct
-        neg = getattr(f, "negative_pivots", None)
-        if neg is None or direct is None:
-            return None
-        n_b = neg()
-        if n_b is None:
-            return None
-        if self.Gf is None:
-            return int(n_b)
+        n_b = self._bordered_negative_pivots()
+        if n_b is None or self.Gf is None:
+            return n_b
+        direct = self.direct
+        assert direct is not None  # a count came from it
         na = self.Gf.shape[0]
         if (
             isinstance(direct, _KKTSolver)
@@ -535,13 +539,9 @@ class BorderedSystem:
             and self._released is not None
         ):
             return self._released_inertia()
-        if isinstance(direct, _DirectSolver):
-            assert direct.S_inv is not None  # kept with actuators
-            S_inv = 0.5 * (direct.S_inv + direct.S_inv.T)  # (G A^-1 G^T)^-1
-            n_b += int(np.sum(np.linalg.eigvalsh(S_inv) > 0))
         _, Y = direct.solve(np.zeros((len(self.free_idx), na)), np.eye(na))
         Y = np.asarray(Y).reshape(na, na)
-        return int(n_b) - int(np.sum(np.linalg.eigvalsh(0.5 * (Y + Y.T)) < 0))
+        return n_b - int(np.sum(np.linalg.eigvalsh(0.5 * (Y + Y.T)) < 0))
 
     def _keep(self, direct: _DirectSolver | _KKTSolver, t_start: float) -> None:
         """Make ``direct`` the factorisation of the current operator."""
