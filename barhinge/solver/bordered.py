@@ -487,8 +487,9 @@ class BorderedSystem:
         factor gives no inertia or no factor is kept. Without actuators: ``K_t``'s count.
 
         For ``G`` of full row rank ``In(B) = In(Z^T K_t Z) + (n_act, n_act, 0)`` for the
-        bordered matrix ``B = [K_t G^T; G 0]`` (Gould 1985, Math. Prog. 32, Lemma 3.4), so
-        the count is ``neg(B) - n_act``: the saddle-point factorisation gives ``neg(B)``,
+        bordered matrix ``B = [K_t G^T; G 0]`` (Nocedal & Wright 2006, Numerical
+        Optimization, Thm. 16.3; Gould 1985, Math. Prog. 32), so the count is
+        ``neg(B) - n_act``: the saddle-point factorisation gives ``neg(B)``,
         the Schur route ``neg(A) + neg(-S)`` (``A = K_t + p G^T G``, ``S = G A^-1 G^T``,
         Haynsworth). Read it before :meth:`tangent_negative_eigenvalues`, which may release
         the bordered factor."""
