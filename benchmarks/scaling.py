@@ -170,21 +170,15 @@ def pieces(n: int) -> dict:
     peak_fact = _peak_mb()
     factor_bytes = getattr(sysm.backend, "factor_bytes", None)
     factor_mb = factor_bytes() / 2**20 if factor_bytes is not None else None
-    # the stability events' count of the released tangent as in a fold's step: the count
-    # (the first with its backend's ordering and analysis; a large bordered factor is
-    # released before it), the next step's factorisation, the count again
-    sysm.release_before_count = True
-    counts = []
-    for k in range(2):
-        if k:
-            t0 = time.perf_counter()
-            sysm.set_operator(ev.K, terms, mu, 1.0, factorize=True)
-            fact_after = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        sysm.tangent_negative_eigenvalues()
-        counts.append(time.perf_counter() - t0)
-        if not k:
-            released = sysm.direct is None  # the bordered factor was released for the count
+    # the stability events' counts of a state as a fold reads them after its last
+    # factorisation (released: from the Schur complement PARDISO computed with it, or a
+    # factorisation of the released tangent on the other routes)
+    t0 = time.perf_counter()
+    sysm.held_negative_eigenvalues()
+    sysm.tangent_negative_eigenvalues()
+    count = time.perf_counter() - t0
+    schur = getattr(sysm.factor, "schur_complement", None)
+    route = "schur" if schur is not None and schur() is not None else "released factor"
     return {
         "n": n,
         "dof": int(model.n_dof),
@@ -197,11 +191,9 @@ def pieces(n: int) -> dict:
         "fact": float(np.median(refact)),
         "solve": float(np.median(solves)),
         "peak_mb": peak_fact,
-        "stability_first": counts[0],
-        "fact_after_release": fact_after,
-        "bordered_released": released,
-        "stability": counts[1],
-        "peak_stability_mb": _peak_mb(),
+        "count": count,
+        "count_route": route,
+        "peak_count_mb": _peak_mb(),
         "factor_mb": factor_mb,
         "assembler_mb": model.assembler.nbytes / 2**20,
     }
@@ -313,9 +305,9 @@ def _steps(steps: list[int] | None) -> str:
 
 
 def stability_lines(rows: list[dict]) -> list[str]:
-    """What the stability events cost the largest fold of each stiffness set: one
-    factorisation of the released tangent per state on top of Newton's (docs/solver.md,
-    *Stability events*), so such a fold takes at least twice its floor."""
+    """Where the factorisations of the largest fold of each stiffness set go: Newton's, and
+    those made only to confirm a stability count at a state (docs/solver.md, *Stability
+    events*)."""
     out = []
     for mat in dict.fromkeys(r["material"] for r in rows):
         r = max((r for r in rows if r["material"] == mat), key=lambda r: r["dof"])
@@ -323,17 +315,17 @@ def stability_lines(rows: list[dict]) -> list[str]:
             continue
         n_stab, nf, steps = r["stability_factorizations"], r["factorizations"], r["steps"]
         out.append(
-            f"- {mat}, n = {r['n']}: {n_stab} of its {nf} factorisations are the stability "
-            f"events' (the released tangent at each state), {nf - n_stab} are Newton's "
-            f"({(nf - n_stab) / steps:.2f} per step against the floor's 1)."
+            f"- {mat}, n = {r['n']}: {nf} factorisations, {nf - n_stab} of them Newton's "
+            f"({(nf - n_stab) / steps:.2f} per step against the floor's 1) and {n_stab} made "
+            "only to confirm a stability count at a state."
         )
     if not out:
         return []
     return [
         "",
-        "Factorisations of the largest folds: the stability events factorise the tangent "
-        "with the actuators released at every state, one factorisation per step on top of "
-        "Newton's, so a fold that reports them takes at least twice its floor:",
+        "Factorisations of the largest folds (the stability counts of a state, actuators "
+        "released and held, come with Newton's last factorisation; one that changed from the "
+        "previous state's is confirmed by a factorisation at the state):",
         "",
         *out,
     ]
@@ -395,15 +387,15 @@ def pieces_lines(r: dict, rows: list[dict], steps: int) -> list[str]:
         f"| refactorisation (median of {REPEATS}) | {r['fact']:.1f} | {r['peak_mb']:.0f} |",
         f"| bordered solve (median of {REPEATS}) | {r['solve']:.2f} | |",
     ]
-    if r.get("stability") is not None:
+    if r.get("count") is not None:
+        how = (
+            "the released one from the Schur complement of the refactorisation"
+            if r.get("count_route") == "schur"
+            else "the released tangent factorised"
+        )
         lines += [
-            "| stability events' count (released tangent factorised), first call: ordering "
-            f"and factorisation | {r['stability_first']:.1f} | |",
-            "| the next factorisation"
-            f"{' (of the released factor)' if r.get('bordered_released') else ''} | "
-            f"{r['fact_after_release']:.1f} | |",
-            "| stability events' count, later call | "
-            f"{r['stability']:.1f} | {r['peak_stability_mb']:.0f} |",
+            f"| stability counts of a state, held and released ({how}) | {r['count']:.2f} "
+            f"| {r['peak_count_mb']:.0f} |",
         ]
     iteration = r["assembly"] + r["fact"] + r["solve"]
     lines += [
@@ -419,18 +411,10 @@ def pieces_lines(r: dict, rows: list[dict], steps: int) -> list[str]:
             f" MB; the process's peak after the refactorisation is "
             f"{r['peak_mb'] / r['factor_mb']:.1f} times the factor.",
         ]
-        if r.get("peak_stability_mb"):
-            held = (
-                "the bordered factor was released before that count, so the two factors are "
-                "never held together"
-                if r.get("bordered_released")
-                else "the bordered factor (below the size that is released) stays alive"
-            )
+        if r.get("count_route") == "schur":
             lines[-1] += (
-                " A fold that reports stability events with many actuators also factorises "
-                "the released tangent at every state (docs/solver.md, `stability_check`); "
-                f"{held}: the peak through the counts is "
-                f"{r['peak_stability_mb'] / r['factor_mb']:.1f} times the bordered factor."
+                " The stability counts read the Schur complement the refactorisation "
+                "computed (docs/solver.md, *Stability events*): no second factor."
             )
     quasi = [q for q in rows if q["material"] == "quasi-rigid"]
     if any(q["n"] == r["n"] for q in quasi):

@@ -34,6 +34,7 @@ reused as the preconditioner of GMRES on later tangents (:class:`BorderedSystem`
 from __future__ import annotations
 
 import dataclasses
+import logging
 import time
 from typing import Any
 
@@ -47,6 +48,8 @@ from barhinge.linalg.indices import index_dtype
 from barhinge.linalg.inertia import InertiaCounter
 
 __all__ = ["ActuatorTerms", "BorderedSystem", "Timer", "actuator_terms", "hinge_derivatives"]
+
+log = logging.getLogger("barhinge.solver.bordered")
 
 
 @dataclasses.dataclass
@@ -148,6 +151,11 @@ class _DirectSolver:
 #: state on the solves against 0.18 s per factorisation, and the solves grow with the
 #: number of actuators
 RELEASED_FACTOR_MIN_ACT = 8
+
+#: backends with a Schur complement (PARDISO) factorise the bordered matrix unaugmented with
+#: the multipliers last and read the released tangent's inertia from it (no factorisation
+#: of its own, :class:`BorderedSystem`); False: the routes above
+SCHUR_COUNTS = True
 
 
 @dataclasses.dataclass
@@ -251,6 +259,14 @@ class BorderedSystem:
         self._penalty_blocks: np.ndarray | None = None
         self._released: tuple[np.ndarray, np.ndarray] | None = None
         self._released_counter: InertiaCounter | None = None
+        #: factorise the bordered matrix ``[K_t G^T; G 0]`` (no augmentation) with the
+        #: multipliers last and the Schur complement ``-G K_t^-1 G^T`` beside the factor
+        #: (backends with ``schur_complement``): the released tangent's inertia then comes
+        #: with every factorisation (Haynsworth), not from one of its own. Off for the rest
+        #: of the solve once K_t itself is singular (perturbed pivots), where the augmented
+        #: matrix ``K_t + p G^T G`` is factorised instead.
+        self._schur_counts = SCHUR_COUNTS and bool(getattr(backend, "schur_complement", False))
+        self._augmentation: tuple[float, np.ndarray] | None = None  # (p, grad) asked
         #: release a bordered factor larger than ``InertiaCounter.RELEASE_ABOVE`` before the
         #: released tangent is factorised (the two are then never held together): for
         #: callers whose next solve follows a new factorisation (the increments of parameter
@@ -355,6 +371,9 @@ class BorderedSystem:
                 m[:, None, None] * terms.hess + k[:, None, None] * g[:, :, None] * g[:, None, :]
             )
         elif na:
+            self._augmentation = (penalty, g)
+            if self._schur_counts:
+                penalty = 0.0  # the Schur complement of K_t itself gives its inertia
             self._penalty_blocks = penalty * g[:, :, None] * g[:, None, :]
             blocks = mu[:, None, None] * terms.hess + self._penalty_blocks
         else:
@@ -448,6 +467,12 @@ class BorderedSystem:
         if self.Gf is not None and getattr(self.backend, "saddle_point", False):
             if self._factorize_kkt(t_start):
                 return
+            if self._schur_counts:
+                # K_t itself is singular: the augmented bordered matrix from now on
+                self._augment()
+                t_start = time.perf_counter()
+                if self._factorize_kkt(t_start):
+                    return
             # perturbed pivots: the bordered matrix is (nearly) singular. Factorise A and the
             # Schur complement instead, which names the cause (redundant actuators) or, if
             # only the bordered pivoting struggled, solves exactly.
@@ -479,6 +504,23 @@ class BorderedSystem:
                     "actuators are redundant or fixed by supports"
                 )
         self._keep(_DirectSolver(self.factor, self.Gf, Z, S_inv, self.penalty), t_start)
+
+    def _augment(self) -> None:
+        """Stop the Schur-complement factorisations for the rest of the solve and make the
+        current operator the augmented ``K_t + sum mu_a H_a + p G^T G`` asked for."""
+        self._schur_counts = False
+        assert self._augmentation is not None  # set with an operator with actuators
+        p, g = self._augmentation
+        pen = p * g[:, :, None] * g[:, None, :]
+        if len(self._blocks):
+            self._blocks = self._blocks + pen
+        else:  # the blocks went into K's values (a pattern without them)
+            self._blocks = pen
+        self._penalty_blocks = pen
+        self.penalty = p
+        self._A = None
+        self._full = None
+        log.debug("bordered matrix singular without augmentation: augmented from here on")
 
     def held_negative_eigenvalues(self) -> int | None:
         """Negative eigenvalues of the free-DOF tangent ``K_t`` with the actuators *held*:
@@ -534,6 +576,10 @@ class BorderedSystem:
         direct = self.direct
         assert direct is not None  # a count came from it
         na = self.Gf.shape[0]
+        schur = getattr(self.factor, "schur_complement", None)
+        S = schur() if schur is not None and isinstance(direct, _KKTSolver) else None
+        if S is not None:  # B's own Schur complement -G K_t^-1 G^T (no augmentation)
+            return n_b - int(np.sum(np.linalg.eigvalsh(S) < 0))
         if (
             isinstance(direct, _KKTSolver)
             and na >= RELEASED_FACTOR_MIN_ACT
@@ -562,7 +608,8 @@ class BorderedSystem:
         assert self.Gf is not None  # called with actuators only
         # saddle-point backends take the upper triangle (``upper``)
         factorize: Any = self.backend.factorize
-        self.factor = factorize(self._kkt_matrix(upper=True), upper=True)
+        schur = {"schur": self.Gf.shape[0]} if self._schur_counts else {}
+        self.factor = factorize(self._kkt_matrix(upper=True), upper=True, **schur)
         self.timer.factorize += time.perf_counter() - t_start
         self.timer.n_factorizations += 1
         perturbed = getattr(self.factor, "perturbed_pivots", None)

@@ -119,6 +119,49 @@ def test_pardiso_factorises_a_saddle_point_matrix():
     assert f.negative_pivots() == 4
 
 
+def _bordered_upper(A: sp.csr_matrix, G: sp.csr_matrix) -> sp.csr_matrix:
+    """Upper triangle (CSR, sorted, every diagonal entry stored) of ``[A G^T; G 0]``."""
+    m = G.shape[0]
+    Z = sp.csr_matrix((np.zeros(m), (np.arange(m), np.arange(m))), shape=(m, m))
+    U = sp.triu(sp.bmat([[A, G.T], [G, Z]], format="csr"), format="csr")
+    U.sort_indices()
+    return U
+
+
+@needs_pardiso
+def test_pardiso_schur_complement_of_the_trailing_rows():
+    """``factorize(U, upper=True, schur=m)`` on ``B = [A G^T; G 0]`` (A indefinite, 7
+    negative eigenvalues): the Schur complement it returns is ``-G A^-1 G^T`` (dense
+    solve), the factor still solves with B, its inertia is B's, and Haynsworth's formula
+    ``In(B) = In(A) + In(-G A^-1 G^T)`` gives A's 7 from it. The same backend then factorises
+    plain, a refactorisation, and a Schur factorisation again (each analysis starts afresh:
+    a Schur analysis leaves PARDISO's "user permutation" flag set, which crashed MKL on the
+    next plain one)."""
+    rng = np.random.default_rng(3)
+    A = _sym_indefinite(40, 7, 1)
+    G = sp.csr_matrix(sp.random(5, 40, density=0.3, random_state=rng) + sp.eye(5, 40))
+    Bd = sp.bmat([[A, G.T], [G, None]]).toarray()
+    backend = get_backend("pardiso")
+    b = rng.random(45)
+    for schur in (5, 0, 5):
+        for scale in (1.0, 1.3):  # analysis, then a numeric refactorisation
+            U = _bordered_upper((scale * A).tocsr(), G)
+            f = backend.factorize(U, upper=True, schur=schur)
+            Bs = Bd.copy()
+            Bs[:40, :40] *= scale
+            np.testing.assert_allclose(f.solve(b), np.linalg.solve(Bs, b), rtol=1e-8)
+            assert f.negative_pivots() == int(np.sum(np.linalg.eigvalsh(Bs) < 0))
+            S = f.schur_complement()
+            if not schur:
+                assert S is None
+                continue
+            Gd = G.toarray()
+            want = -Gd @ np.linalg.solve(scale * A.toarray(), Gd.T)
+            np.testing.assert_allclose(S, want, rtol=1e-9, atol=1e-12 * np.abs(want).max())
+            released = f.negative_pivots() - int(np.sum(np.linalg.eigvalsh(S) < 0))
+            assert released == 7
+
+
 @needs_pardiso
 def test_pardiso_rejects_a_missing_diagonal_and_singular():
     M = sp.csr_matrix(np.array([[0.0, 1.0], [1.0, 0.0]]))  # no stored diagonal

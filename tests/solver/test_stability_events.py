@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 import json
+import logging
 import math
 from pathlib import Path
 
@@ -50,13 +51,15 @@ def _vm_scene(steps: int = 20, factor: float = 1.5, **opts) -> Scene:
 
 
 # ------------------------------------------------------------------ inertia
-@pytest.mark.parametrize("route", ["haynsworth", "released factor"])
+@pytest.mark.parametrize("route", ["schur complement", "haynsworth", "released factor"])
 @pytest.mark.parametrize("name", available_backends())
 def test_released_inertia_from_the_bordered_factorisation_matches_dense(name, route, monkeypatch):
     """neg(K_t) = neg([K_t G^T; G 0]) - neg(Y), Y the multiplier block of the inverse
-    (Haynsworth), or (many actuators) the pivots of a factorisation of K_t itself: both
-    checked on a Miura tangent shifted to 0, 3, 7 and 11 negative eigenvalues; and the held
-    count neg([K_t G^T; G 0]) - n_act against the eigenvalues of ``Z^T K_t Z`` (G Z = 0)."""
+    (Haynsworth), or the Schur complement ``-G K_t^-1 G^T`` the bordered factorisation
+    computes beside its factor (PARDISO), or (many actuators, no such complement) the
+    pivots of a factorisation of K_t itself: each checked on a Miura tangent shifted to 0,
+    3, 7 and 11 negative eigenvalues; and the held count neg([K_t G^T; G 0]) - n_act
+    against the eigenvalues of ``Z^T K_t Z`` (G Z = 0)."""
     from barhinge.solver import bordered
 
     min_act = 1 if route == "released factor" else 10**9
@@ -81,7 +84,10 @@ def test_released_inertia_from_the_bordered_factorisation_matches_dense(name, ro
     for n_neg in (0, 3, n0, n0 + 4):
         shift = w[0] - 1.0 if n_neg == 0 else 0.5 * (w[n_neg - 1] + w[n_neg])
         sysm = BorderedSystem(get_backend(name), free, terms.dofs, Timer())
+        schur = sysm._schur_counts and route == "schur complement"
+        sysm._schur_counts = schur
         sysm.factorize((K - shift * sp.identity(K.shape[0])).tocsr(), terms, mu, penalty=50.0)
+        assert (sysm.factor.schur_complement() is not None) if schur else True
         held = np.linalg.eigvalsh(Z.T @ (Ktf - shift * np.eye(len(Ktf))) @ Z)
         assert sysm.held_negative_eigenvalues() == int(np.sum(held < 0)), (name, n_neg)
         got = sysm.tangent_negative_eigenvalues()
@@ -90,6 +96,8 @@ def test_released_inertia_from_the_bordered_factorisation_matches_dense(name, ro
         took = sysm._released_counter is not None
         saddle = getattr(sysm.backend, "saddle_point", False)
         assert took == (route == "released factor" and saddle), name
+        if route == "schur complement":
+            assert schur == (name == "pardiso"), name
 
 
 @pytest.mark.parametrize("name", available_backends())
@@ -143,28 +151,80 @@ def test_failed_fold_increment_names_the_instability_its_iterates_met():
     assert d.inertia.failure_text("residual diverged", held_before=0) == ""
 
 
-@pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO releases factors")
-def test_released_bordered_factor_gives_the_same_fold(monkeypatch):
-    """Above ``InertiaCounter.RELEASE_ABOVE`` the bordered factor is released before the
-    released tangent is factorised for the stability count (never two factors at once):
-    the fold (a 3 x 3 Miura with 6 line actuators on the released-factor route, 8 steps
-    from 50 deg) is the same state for state, with the same counts, as with every factor
-    kept; the released factors are really released, and arc length keeps its factor."""
-    from barhinge.linalg import inertia
-    from barhinge.linalg.backends import PardisoBackend
-    from barhinge.solver import bordered
-
-    monkeypatch.setattr(bordered, "RELEASED_FACTOR_MIN_ACT", 1)
+def _miura_line_fold(fold_stiffness: float) -> Scene:
+    """A 3 x 3 Miura with its 6 line creases driven from 50 to 20 deg in 8 steps."""
     cp = bh.families.miura(3, 3, alpha=60.0, fold=50.0)
-    model = BarHingeModel.from_pattern(cp, "N5B8", fold_stiffness=0.1, bar_EA=1e3)
+    model = BarHingeModel.from_pattern(cp, "N5B8", fold_stiffness=fold_stiffness, bar_EA=1e3)
     edges = miura_line_creases(cp)
     targets = np.asarray(bh.families.miura(3, 3, alpha=60.0, fold=20.0).fold_angles)[edges]
-    scene = Scene(
+    return Scene(
         model,
         actuators=bh.Actuators(edges=edges, targets_deg=targets),
         steps=8,
         options={"linear_solver": "pardiso"},
     )
+
+
+@pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO Schur complement")
+def test_schur_complement_counts_give_the_same_fold_without_count_factorisations(monkeypatch):
+    """The released count from the Schur complement of Newton's bordered factorisation
+    (PARDISO, the default) against the released tangent factorised at every state (the
+    route of other backends with many actuators): the same states, the same counts of both
+    kinds, and the count factorisations gone (every state's released count was one)."""
+    from barhinge.solver import bordered
+
+    monkeypatch.setattr(bordered, "RELEASED_FACTOR_MIN_ACT", 1)
+    scene = _miura_line_fold(0.1)
+    schur = bh.solve(scene)
+    monkeypatch.setattr(bordered, "SCHUR_COUNTS", False)
+    factored = bh.solve(scene)
+    scale = float(np.abs(factored.X[0]).max())
+    assert np.abs(schur.X - factored.X).max() <= 1e-9 * scale
+    assert np.abs(factored.X[-1] - factored.X[0]).max() > 0.05 * scale  # it folded
+    for key in ("negative_eigenvalues", "negative_eigenvalues_held"):
+        assert schur.meta[key] == factored.meta[key], key
+    n_states = scene.steps + 1
+    fewer = sum(factored.meta["newton"]["factorizations"]) - sum(
+        schur.meta["newton"]["factorizations"]
+    )
+    assert fewer >= n_states - 1  # the states after the first, each counted by its own
+
+
+@pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO Schur complement")
+def test_a_tangent_singular_with_the_actuators_released_takes_the_augmented_matrix(
+    monkeypatch, caplog
+):
+    """No fold springs: the Miura's rigid-folding mode makes ``K_t`` singular, which the
+    Schur-complement factorisation (``K_t`` eliminated first) meets as perturbed pivots.
+    The solve switches to the augmented bordered matrix ``K_t + p G^T G`` (and the released
+    tangent's own factorisation for its count) and gives exactly the fold of that route."""
+    from barhinge.solver import bordered
+
+    scene = _miura_line_fold(0.0)
+    with caplog.at_level(logging.DEBUG, logger="barhinge.solver.bordered"):
+        switched = bh.solve(scene)
+    assert "augmented from here on" in caplog.text
+    monkeypatch.setattr(bordered, "SCHUR_COUNTS", False)
+    augmented = bh.solve(scene)
+    np.testing.assert_array_equal(switched.X, augmented.X)
+    for key in ("negative_eigenvalues", "negative_eigenvalues_held"):
+        assert switched.meta[key] == augmented.meta[key], key
+
+
+@pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO releases factors")
+def test_released_bordered_factor_gives_the_same_fold(monkeypatch):
+    """Above ``InertiaCounter.RELEASE_ABOVE`` the bordered factor is released before the
+    released tangent is factorised for the stability count (never two factors at once):
+    the fold (:func:`_miura_line_fold` on the released-factor route) is the same state for
+    state, with the same counts, as with every factor kept; the released factors are really
+    released, and arc length keeps its factor."""
+    from barhinge.linalg import inertia
+    from barhinge.linalg.backends import PardisoBackend
+    from barhinge.solver import bordered
+
+    monkeypatch.setattr(bordered, "RELEASED_FACTOR_MIN_ACT", 1)
+    monkeypatch.setattr(bordered, "SCHUR_COUNTS", False)
+    scene = _miura_line_fold(0.1)
     released = []
     real_release = PardisoBackend.release
     monkeypatch.setattr(
