@@ -402,9 +402,10 @@ class PardisoBackend:
 
         ``schur`` = k > 0 (indefinite mode, ``upper`` only): the last k rows are ordered
         last and the factor also holds the dense Schur complement of that trailing block
-        (:meth:`_PardisoFactor.schur_complement`), at the cost of the factorisation alone
-        (a 70 x 70 Miura bordered matrix with 140 multipliers: 0.40 s either way). Its
-        leading block is eliminated first, so a singular leading block perturbs pivots."""
+        (:meth:`_PardisoFactor.schur_complement`) for little more than the factorisation
+        (Miura bordered matrices: 0.40 s either way at 118 443 rows and 140 multipliers,
+        7.7 s against 6.7 s at 962 403 rows and 400). Its leading block is eliminated
+        first, so a singular leading block perturbs pivots."""
         if upper:
             U = A
             sample = U.indices[:: max(1, U.nnz // 997)]
