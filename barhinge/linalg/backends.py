@@ -428,6 +428,8 @@ class PardisoBackend:
                 # handle of a plain one)
                 if schur or int(s.iparm[35]):
                     s.free_memory(everything=True)
+                    self._generation += 1  # earlier factors must not solve with it
+                    self._held = False
                 s.iparm[:] = self._iparm0
                 s.set_iparm(36, self.SCHUR_MODE if schur else 0)
                 s.perm = np.zeros(N if schur else 0, np.int32)

@@ -569,7 +569,9 @@ class BorderedSystem:
         have the inertia of B). Haynsworth's formula on ``K_t`` gives
         ``In(B) = In(K_t) + In(Y)`` with ``Y = -(G K_t^-1 G^T)^-1``, the multiplier block of
         ``B^-1``: ``n_act`` solves with the factorisation at hand (valid while K_t is
-        nonsingular, i.e. away from the critical point itself)."""
+        nonsingular, i.e. away from the critical point itself). A PARDISO factorisation of
+        B with the multipliers last carries ``Y^-1 = -G K_t^-1 G^T`` itself (its Schur
+        complement, :attr:`_schur_counts`): then no solve at all."""
         n_b = self._bordered_negative_pivots()
         if n_b is None or self.Gf is None:
             return n_b

@@ -143,10 +143,12 @@ def test_pardiso_schur_complement_of_the_trailing_rows():
     Bd = sp.bmat([[A, G.T], [G, None]]).toarray()
     backend = get_backend("pardiso")
     b = rng.random(45)
+    factors = []
     for schur in (5, 0, 5):
         for scale in (1.0, 1.3):  # analysis, then a numeric refactorisation
             U = _bordered_upper((scale * A).tocsr(), G)
             f = backend.factorize(U, upper=True, schur=schur)
+            factors.append(f)
             Bs = Bd.copy()
             Bs[:40, :40] *= scale
             np.testing.assert_allclose(f.solve(b), np.linalg.solve(Bs, b), rtol=1e-8)
@@ -160,6 +162,9 @@ def test_pardiso_schur_complement_of_the_trailing_rows():
             np.testing.assert_allclose(S, want, rtol=1e-9, atol=1e-12 * np.abs(want).max())
             released = f.negative_pivots() - int(np.sum(np.linalg.eigvalsh(S) < 0))
             assert released == 7
+    for old in factors[:-1]:  # every analysis freed the handle: no solve with a freed factor
+        with pytest.raises(RuntimeError, match="replaced"):
+            old.solve(b)
 
 
 @needs_pardiso
