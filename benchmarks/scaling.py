@@ -126,6 +126,21 @@ def one(n: int, steps: int, material: str) -> dict:
     }
 
 
+def _refactor_and_solve(sysm, K, terms, mu: np.ndarray) -> tuple[float, float]:
+    """Medians of ``REPEATS`` numeric refactorisations of the bordered system ``sysm`` with
+    the tangent ``K`` (its pattern analysed already) and of a bordered solve after each
+    (seconds)."""
+    refact, solves = [], []
+    for _ in range(REPEATS):
+        t0 = time.perf_counter()
+        sysm.set_operator(K, terms, mu, 1.0, factorize=True)
+        refact.append(time.perf_counter() - t0)
+        t0 = time.perf_counter()
+        sysm.solve(np.ones(len(sysm.free_idx)), np.zeros(len(mu)))
+        solves.append(time.perf_counter() - t0)
+    return float(np.median(refact)), float(np.median(solves))
+
+
 def pieces(n: int) -> dict:
     """Build, first assembly (peak memory after it), factorisations, bordered solves and the
     stability events' count of the released tangent at the flat state of the n x n sheet, in
@@ -159,14 +174,7 @@ def pieces(n: int) -> dict:
     t0 = time.perf_counter()
     sysm.set_operator(ev.K, terms, mu, 1.0, factorize=True)
     fact1 = time.perf_counter() - t0
-    refact, solves = [], []
-    for _ in range(REPEATS):
-        t0 = time.perf_counter()
-        sysm.set_operator(ev.K, terms, mu, 1.0, factorize=True)
-        refact.append(time.perf_counter() - t0)
-        t0 = time.perf_counter()
-        sysm.solve(np.ones(int(free.sum())), np.zeros(len(hinges)))
-        solves.append(time.perf_counter() - t0)
+    fact, solve = _refactor_and_solve(sysm, ev.K, terms, mu)
     peak_fact = _peak_mb()
     factor_bytes = getattr(sysm.backend, "factor_bytes", None)
     factor_mb = factor_bytes() / 2**20 if factor_bytes is not None else None
@@ -188,15 +196,7 @@ def pieces(n: int) -> dict:
         plain = BorderedSystem(get_backend("auto"), free, terms.dofs, Timer())
         plain._schur_counts = False
         plain.set_operator(ev.K, terms, mu, 1.0, factorize=True)  # with the ordering
-        refact_p, solves_p = [], []
-        for _ in range(REPEATS):
-            t0 = time.perf_counter()
-            plain.set_operator(ev.K, terms, mu, 1.0, factorize=True)
-            refact_p.append(time.perf_counter() - t0)
-            t0 = time.perf_counter()
-            plain.solve(np.ones(int(free.sum())), np.zeros(len(hinges)))
-            solves_p.append(time.perf_counter() - t0)
-        plain_fact, plain_solve = float(np.median(refact_p)), float(np.median(solves_p))
+        plain_fact, plain_solve = _refactor_and_solve(plain, ev.K, terms, mu)
     return {
         "n": n,
         "dof": int(model.n_dof),
@@ -206,8 +206,8 @@ def pieces(n: int) -> dict:
         "assembly": float(np.median(later)),
         "mem_assembly_mb": mem_assembly,
         "fact_first": fact1,
-        "fact": float(np.median(refact)),
-        "solve": float(np.median(solves)),
+        "fact": fact,
+        "solve": solve,
         "peak_mb": peak_fact,
         "count": count,
         "count_route": route,
