@@ -19,14 +19,13 @@ entries (the 12-node hinges have 78 upper entries in 10 node pairs), at the same
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
-from barhinge.linalg.indices import index_dtype
+from barhinge.linalg.indices import index_dtype, pattern_positions
 
 __all__ = ["Assembler", "PackedRows", "element_dofs"]
 
@@ -46,16 +45,33 @@ def element_dofs(conn: np.ndarray) -> np.ndarray:
     )
 
 
-def _node_pair_keys(conn: np.ndarray, n_nodes: int) -> np.ndarray:
-    """``min * n_nodes + max`` of every node pair ``(a, b)``, ``a <= b`` locally, of every
-    element (entry-major: pair by pair, the elements within)."""
+def _node_pairs(conn: np.ndarray, itype: type[np.signedinteger]) -> tuple[np.ndarray, np.ndarray]:
+    """``(min, max)`` of every node pair ``(a, b)``, ``a <= b`` locally, of every element
+    (entry-major: pair by pair, the elements within), as ``itype`` arrays."""
     la, lb = np.triu_indices(conn.shape[1])
-    cT = np.ascontiguousarray(conn.T)  # node slot-major: the pair rows below are contiguous
+    cT = np.ascontiguousarray(conn.T, dtype=itype)  # node slot-major: pair rows contiguous
     A, B = cT[la], cT[lb]
-    keys = np.minimum(A, B)
-    keys *= n_nodes
-    keys += np.maximum(A, B)
-    return keys.ravel()
+    return np.minimum(A, B).ravel(), np.maximum(A, B).ravel()
+
+
+def _block_pattern(
+    lo: np.ndarray, hi: np.ndarray, n_nodes: int
+) -> tuple[np.ndarray, np.ndarray, sp.csr_matrix]:
+    """The distinct node pairs ``(lo, hi)`` (``lo <= hi``) in row-major order and a CSR
+    matrix of them whose values are their ordinals (float, exact below 2**53).
+
+    scipy's COO-to-CSR conversion counts the pairs into rows and merges duplicates within a
+    row (a bucket sort): several times faster and smaller than ``numpy.unique`` of 64-bit
+    keys on the millions of node pairs of coupled hinges."""
+    S = sp.csr_matrix((np.ones(len(lo), bool), (lo, hi)), shape=(n_nodes, n_nodes))
+    S.sum_duplicates()
+    nblk = S.nnz
+    rows = np.repeat(np.arange(n_nodes, dtype=S.indices.dtype), np.diff(S.indptr))
+    ordinals = sp.csr_matrix(
+        (np.arange(nblk, dtype=float), S.indices, S.indptr), shape=S.shape, copy=False
+    )
+    ordinals.has_canonical_format = True
+    return rows, S.indices, ordinals
 
 
 #: component ``3 j + i`` of a 3x3 block for its component ``3 i + j`` (the transpose)
@@ -110,19 +126,22 @@ class Assembler:
         n_packed = sum(len(iu) * len(c) for c, (iu, _) in zip(conns, self.triu, strict=True))
 
         # 1. node-pair blocks: every element couples its node pairs (a <= b locally)
-        pair_keys = [_node_pair_keys(c, N) for c in conns]
-        pair_of = [np.triu_indices(c.shape[1]) for c in conns]
-        n_valued = sum(len(k) for k in pair_keys)  # the pattern groups' keys come after
-        pair_keys += [_node_pair_keys(np.asarray(g, dtype=np.int64), N) for g in pattern_groups]
-        allp = np.concatenate(pair_keys) if pair_keys else np.zeros(0, np.int64)
-        del pair_keys
-        ublk, inv = np.unique(allp, return_inverse=True)
-        del allp
-        nblk = len(ublk)
+        n_inst = sum(len(np.triu_indices(c.shape[1])[0]) * len(c) for c in conns)
+        ntype = index_dtype(N)
+        pairs = [_node_pairs(c, ntype) for c in conns]
+        pairs += [_node_pairs(np.asarray(g), ntype) for g in pattern_groups]
+        lo = np.concatenate([a for a, _ in pairs]) if pairs else np.zeros(0, ntype)
+        hi = np.concatenate([b for _, b in pairs]) if pairs else np.zeros(0, ntype)
+        del pairs
+        bA, bB, ordinals = _block_pattern(lo, hi, N)
+        nblk = len(bA)
         self.n_upper = 9 * nblk  # a 3x3 slot per node-pair block (upper part on diagonals)
         # index dtype of every map below: int32 wherever the counts allow (halves the maps)
         itype = index_dtype(n_packed, 2 * self.n_upper, n)
-        inv = inv.ravel()[:n_valued].astype(itype)
+        # the block of every valued instance (the pattern groups' pairs come after them)
+        inv = np.asarray(ordinals[lo[:n_inst], hi[:n_inst]]).ravel().astype(itype)
+        del lo, hi, ordinals
+        pair_of = [np.triu_indices(c.shape[1]) for c in conns]
         self._fdofs = self._fdofs.astype(itype)
         self.dofs = [D.astype(itype) for D in self.dofs]
 
@@ -131,7 +150,6 @@ class Assembler:
         #    block, 9 components row-major, to one node-pair block; values are stored
         #    component-major, ``(9, n_instances)``. An instance whose first node is the larger
         #    (swapped) adds its block transposed: one summation matrix per orientation.
-        n_inst = sum(len(la) * len(c) for c, (la, _) in zip(conns, pair_of, strict=True))
         swapped = np.empty(n_inst, bool)
         #: per group: (first instance, node pairs, elements, packed entry -> component,
         #: packed entry -> node pair)
@@ -166,8 +184,7 @@ class Assembler:
         self._n_blocks = nblk
 
         # 3. full symmetric CSR pattern from the blocks, and the gather from the block sums
-        bA, bB = (ublk // N).astype(itype), (ublk % N).astype(itype)
-        del ublk
+        bA, bB = bA.astype(itype), bB.astype(itype)
         offd = bA != bB
         rn = np.concatenate([bA, bB[offd]])
         cn = np.concatenate([bB, bA[offd]])
@@ -269,10 +286,22 @@ class Assembler:
             vals = np.zeros(9 * self.n_instances)
             for view, arr in zip(self._group_views(vals), element_upper, strict=False):
                 view.buf[view.comp, view.pair] = arr
-        V = vals.reshape(9, self.n_instances)
+        return self.matrix_from_sums(self.block_sums(vals))
+
+    def block_sums(self, flat: np.ndarray) -> np.ndarray:
+        """(9, n_blocks) sums of the element node-pair blocks of the flat value array of
+        :meth:`value_buffers` (component-major): :meth:`matrix_from_sums` makes the matrix.
+        Between the two the caller can drop the value array (about 0.9 GB at 1 M DOF), so
+        that it is not held beside the matrix's values."""
+        V = flat.reshape(9, self.n_instances)
         sums = np.empty((9, self._n_blocks))
         for c in range(9):
             np.add(self._sum_direct @ V[c], self._sum_swapped @ V[_TRANSPOSED[c]], out=sums[c])
+        return sums
+
+    def matrix_from_sums(self, sums: np.ndarray) -> sp.csr_matrix:
+        """(n_dof, n_dof) CSR matrix of the block sums of :meth:`block_sums` (its values
+        gathered from them; the pattern's arrays shared)."""
         K = sp.csr_matrix(
             (sums.ravel()[self._gather], self.indices, self.indptr),
             shape=(self.n_dof, self.n_dof),
@@ -348,18 +377,10 @@ class Assembler:
 
     def _positions(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """Positions in ``data`` of the entries ``(rows, cols)`` of the pattern."""
-        keys = self._pattern_keys
-        want = rows * self.n_dof + cols
-        pos = np.minimum(np.searchsorted(keys, want), max(len(keys) - 1, 0))
-        if len(want) and not np.array_equal(keys[pos], want):
+        pos = pattern_positions(self.indptr, self.indices, rows, cols)
+        if len(pos) and pos.min() < 0:
             raise ValueError("entries outside the assembler's sparsity pattern")
         return pos
-
-    @functools.cached_property
-    def _pattern_keys(self) -> np.ndarray:
-        """Sorted ``row * n_dof + column`` of every entry of the pattern."""
-        rows = np.repeat(np.arange(self.n_dof, dtype=np.int64), np.diff(self.indptr))
-        return rows * self.n_dof + self.indices
 
     def matrix(self, element_matrices: list[np.ndarray]) -> sp.csr_matrix:
         """(n_dof, n_dof) CSR sum of symmetric element matrices ``(n_el, m, m)`` (element-major

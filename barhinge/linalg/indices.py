@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
-__all__ = ["index_dtype"]
+__all__ = ["index_dtype", "pattern_positions"]
 
 
 def index_dtype(*counts: int) -> type[np.signedinteger]:
@@ -12,3 +13,27 @@ def index_dtype(*counts: int) -> type[np.signedinteger]:
     2**31 - 1 (scipy.sparse's rule), else ``numpy.int64``: 32-bit indices halve the maps,
     and scipy.sparse keeps int32 index arrays of matrices that small without copying."""
     return np.int32 if max(counts, default=0) <= np.iinfo(np.int32).max else np.int64
+
+
+def pattern_positions(
+    indptr: np.ndarray, indices: np.ndarray, rows: np.ndarray, cols: np.ndarray
+) -> np.ndarray:
+    """(len(rows),) int64: the index into the values of the CSR pattern ``(indptr, indices)``
+    (sorted indices, no duplicates) of every entry ``(rows[q], cols[q])``, -1 where the
+    pattern has none.
+
+    One look-up per entry in its row (scipy's CSR sampling: a binary search per entry for
+    many entries), through a CSR of the pattern whose values are the 1-based positions."""
+    rows, cols = np.asarray(rows, np.int64).ravel(), np.asarray(cols, np.int64).ravel()
+    if not len(rows):
+        return np.zeros(0, np.int64)
+    n_rows = len(indptr) - 1
+    n_cols = int(max(indices.max(initial=-1), np.max(cols, initial=-1))) + 1
+    ordinals = sp.csr_matrix(
+        (np.arange(1, len(indices) + 1, dtype=float), indices, indptr),
+        shape=(n_rows, n_cols),
+        copy=False,
+    )
+    ordinals.has_canonical_format = True
+    found = ordinals[rows, cols]
+    return np.asarray(found, dtype=np.int64).ravel() - 1

@@ -557,7 +557,7 @@ class BarHingeModel:
         if tangent:
             flat, (Kb, Hp) = asm.value_buffers()
             # g (12, nh), Hp (78, nh): packed upper triangle of the hinge energy Hessian
-            rho, M, Kt, Wh, g, _ = hinge_energy_hessian_packed(X, hinges, law, Hp)
+            rho, M, Kt, Wh, g, Hp = hinge_energy_hessian_packed(X, hinges, law, Hp)
         else:
             rho, g = hinge_angle_gradient_t(X, hinges)
             M, Kt, Wh = self._hinge_law(rho)
@@ -574,7 +574,10 @@ class BarHingeModel:
             for p_, (q, sgn) in enumerate(zip(_BAR_Q, _BAR_SIGN, strict=True)):
                 if p_ != _BAR_FIRST[q]:
                     np.multiply(Kb[_BAR_FIRST[q]], sgn, out=Kb[p_])
-            K = asm.matrix_packed(flat)
+            sums = asm.block_sums(flat)
+            del flat, Kb, Hp  # a value buffer not kept by the assembler is freed here
+            K = asm.matrix_from_sums(sums)
+            del sums
             if len(self.hinge_pairs):
                 self._add_pair_tangent(K, g)
             if len(self.bar_pairs):

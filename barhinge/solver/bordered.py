@@ -44,7 +44,7 @@ import scipy.sparse.linalg as spla
 
 from barhinge._protocols import SolverModel
 from barhinge.linalg.backends import LinearBackend, SingularMatrixError
-from barhinge.linalg.indices import index_dtype
+from barhinge.linalg.indices import index_dtype, pattern_positions
 from barhinge.linalg.inertia import InertiaCounter
 
 __all__ = ["ActuatorTerms", "BorderedSystem", "Timer", "actuator_terms", "hinge_derivatives"]
@@ -254,6 +254,7 @@ class BorderedSystem:
         self._kkt_gather: np.ndarray | None = None
         self._kkt_g: tuple[np.ndarray, np.ndarray] | None = None
         self._kkt_pattern: tuple | None = None
+        self._kkt_data: np.ndarray | None = None  # the bordered matrix's values (reused)
         # (values of the factorised bordered operator's A, its penalty blocks) for the
         # released tangent's inertia; a backend of its own keeps that factor apart
         self._penalty_blocks: np.ndarray | None = None
@@ -284,26 +285,35 @@ class BorderedSystem:
         if key == self._key:
             return
         self._key = key
-        n = self.n_dof
-        rows = np.repeat(np.arange(n), np.diff(K.indptr))
-        cols = K.indices
-        newidx = np.full(n, -1, np.int64)
-        newidx[self.free_idx] = np.arange(len(self.free_idx))
-        keep = self.free[rows] & self.free[cols]
-        itype = index_dtype(K.nnz)
-        self._sel = np.flatnonzero(keep).astype(itype)
-        r, c = newidx[rows[keep]], newidx[cols[keep]]
-        nf = len(self.free_idx)
-        self._sub_indptr = np.concatenate([[0], np.cumsum(np.bincount(r, minlength=nf))])
-        self._sub_indices = c.astype(np.int32)
+        self._sel = self._sub_indptr = self._sub_indices = None  # built on first use
         # positions of the actuator 12x12 blocks inside K.data (if K's pattern holds them)
         if len(self.act_dofs):
-            pos = _csr_positions(K, *_block_entries(self.act_dofs))
+            pos = pattern_positions(K.indptr, K.indices, *_block_entries(self.act_dofs))
             self._blk_ok = bool(np.all(pos >= 0))
             self._blk_pos = pos
         else:
             self._blk_ok = True
             self._blk_pos = np.zeros(0, np.int64)
+
+    def _submatrix_maps(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(positions in K's values of the free-free entries, sorted; the free submatrix's
+        ``indptr``; its ``indices``) for the pattern of the last :meth:`_prepare`, built on
+        first use: the bordered factorisation needs them once (for its pattern), the free
+        submatrix ``A`` and the released tangent's own factorisation at every use."""
+        if self._sel is None or self._sub_indptr is None or self._sub_indices is None:
+            indices, indptr = self._pattern_arrays
+            n = self.n_dof
+            rows = np.repeat(np.arange(n), np.diff(indptr))
+            newidx = np.full(n, -1, np.int64)
+            newidx[self.free_idx] = np.arange(len(self.free_idx))
+            keep = self.free[rows] & self.free[indices]
+            self._sel = np.flatnonzero(keep).astype(index_dtype(len(indices)))
+            r, c = newidx[rows[keep]], newidx[indices[keep]]
+            del rows, keep
+            nf = len(self.free_idx)
+            self._sub_indptr = np.concatenate([[0], np.cumsum(np.bincount(r, minlength=nf))])
+            self._sub_indices = c.astype(np.int32)
+        return self._sel, self._sub_indptr, self._sub_indices
 
     def _set_values(self, K: sp.csr_matrix, blocks: np.ndarray) -> None:
         """Make K's values (its CSR pattern; not copied) and the actuator blocks
@@ -338,10 +348,8 @@ class BorderedSystem:
         use: the saddle-point path gathers its matrix straight from K's values)."""
         if self._A is None and self._values is not None:
             nf = len(self.free_idx)
-            self._A = sp.csr_matrix(
-                (self._full_values()[self._sel], self._sub_indices, self._sub_indptr),
-                shape=(nf, nf),
-            )
+            sel, indptr, indices = self._submatrix_maps()
+            self._A = sp.csr_matrix((self._full_values()[sel], indices, indptr), shape=(nf, nf))
         return self._A
 
     # ---------------------------------------------------------------- operator
@@ -398,17 +406,21 @@ class BorderedSystem:
         or its upper triangle.
 
         Its pattern is built once (entries tagged with their source position in K's values
-        or G's) and every later call is one gather from K's values and G's."""
+        or G's) and every later call is one gather from K's values and G's, into one values
+        buffer of this system: the matrix returned is overwritten by the next call. (A
+        factorisation replaces the factor of the last matrix, which then cannot solve: the
+        two are never held together, 250 MB at the 1 M DOFs of a 200 x 200 Miura.)"""
         G = self.Gf
         assert G is not None and self._values is not None  # an operator with actuators
-        assert self._sel is not None and self._sub_indptr is not None
         na, nnz_k, nnz_g = G.shape[0], len(self._values), G.nnz
         key = (self._key, upper, nnz_g, hash(G.indptr.tobytes()), hash(G.indices.tobytes()))
         if key != self._kkt_key:
             nf = len(self.free_idx)
-            tag_a = sp.csr_matrix(
-                (self._sel + 1.0, self._sub_indices, self._sub_indptr), shape=(nf, nf)
-            )
+            sel, sub_indptr, sub_indices = self._submatrix_maps()
+            tag_a = sp.csr_matrix((sel + 1.0, sub_indices, sub_indptr), shape=(nf, nf))
+            if self._schur_counts:  # nothing else reads them on this route: freed
+                del sel, sub_indptr, sub_indices
+                self._sel = self._sub_indptr = self._sub_indices = None
             tag_g = sp.csr_matrix(
                 (np.arange(nnz_k + 1.0, nnz_k + nnz_g + 1), G.indices, G.indptr), G.shape
             )
@@ -432,7 +444,9 @@ class BorderedSystem:
         assert self._kkt_pattern is not None and self._kkt_g is not None
         assert self._kkt_gather is not None
         indices, indptr, shape = self._kkt_pattern
-        data = self._values.take(self._kkt_gather)
+        if self._kkt_data is None or len(self._kkt_data) != len(indices):
+            self._kkt_data = np.empty(len(indices))
+        data = self._values.take(self._kkt_gather, out=self._kkt_data)
         if len(self._blocks):  # the actuator blocks, added here: no copy of K's values
             assert self._kkt_blk is not None  # set with the pattern
             entry, at = self._kkt_blk
@@ -458,7 +472,7 @@ class BorderedSystem:
         if upper:
             keep &= r <= c
         entry = np.flatnonzero(keep)
-        at = _pattern_positions(indptr, indices, r[entry], c[entry])
+        at = pattern_positions(indptr, indices, r[entry], c[entry])
         assert np.all(at >= 0)  # the bordered pattern holds A's, which holds the blocks
         return entry, at
 
@@ -630,19 +644,19 @@ class BorderedSystem:
         positive definite, :class:`~barhinge.linalg.inertia.InertiaCounter`); None when its
         backend gives no inertia."""
         assert self._released is not None and self._blk_pos is not None
-        assert self._sel is not None and self._sub_indptr is not None
+        sel, sub_indptr, sub_indices = self._submatrix_maps()
         if self.release_before_count:
             self._release_large_factor()
         data, blocks = self._released
         # the free submatrix of K's values (one copy), the blocks ``mu_a H_a`` added where
         # their entries are free (``_sel`` is sorted)
-        vals = data[self._sel]
-        sub = np.searchsorted(self._sel, self._blk_pos)
+        vals = data[sel]
+        sub = np.searchsorted(sel, self._blk_pos)
         free = sub < len(vals)
-        free[free] = self._sel[sub[free]] == self._blk_pos[free]
+        free[free] = sel[sub[free]] == self._blk_pos[free]
         np.add.at(vals, sub[free], blocks.ravel()[free])
         nf = len(self.free_idx)
-        Kt = sp.csr_matrix((vals, self._sub_indices, self._sub_indptr), (nf, nf))
+        Kt = sp.csr_matrix((vals, sub_indices, sub_indptr), (nf, nf))
         if self._released_counter is None:
             self._released_counter = InertiaCounter(self.backend)
         counter = self._released_counter
@@ -781,28 +795,6 @@ def _block_entries(act_dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(rows, columns) of every entry of the actuators' 12 x 12 blocks ``(n_act, 12, 12)``,
     flattened in the blocks' order (``act_dofs``: (n_act, 12) global DOFs)."""
     return np.repeat(act_dofs, 12, axis=1).ravel(), np.tile(act_dofs, (1, 12)).ravel()
-
-
-def _csr_positions(K: sp.csr_matrix, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
-    """Index into ``K.data`` of each (row, col) pair, -1 where the pattern has no entry.
-    K must have sorted indices."""
-    return _pattern_positions(K.indptr, K.indices, rows, cols)
-
-
-def _pattern_positions(
-    indptr: np.ndarray, indices: np.ndarray, rows: np.ndarray, cols: np.ndarray
-) -> np.ndarray:
-    """Index into the values of the CSR pattern ``(indptr, indices)`` (sorted indices) of
-    each (row, col) pair, -1 where the pattern has no entry."""
-    out = np.full(len(rows), -1, np.int64)
-    start = indptr[rows]
-    end = indptr[rows + 1]
-    for q in range(len(rows)):  # small: 144 entries per actuator
-        s, e = start[q], end[q]
-        k = s + np.searchsorted(indices[s:e], cols[q])
-        if k < e and indices[k] == cols[q]:
-            out[q] = k
-    return out
 
 
 def gdcm_sign(prev_tangent: np.ndarray | None, tangent: np.ndarray, prev_sign: float) -> float:
