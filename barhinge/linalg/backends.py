@@ -414,6 +414,10 @@ class PardisoBackend:
             U = self._upper(A)
             key = self._upper_key
             schur = 0
+        if not np.isfinite(U.data).all():
+            # MKL factorises NaN into NaN solves and crashed analysing infinite values
+            # after a factorisation of NaN: refused before it reaches PARDISO
+            raise SingularMatrixError("PARDISO: the matrix has non-finite entries")
         s = self._solver
         N = U.shape[0]
         # the Schur complement is written into the first k^2 entries of the output

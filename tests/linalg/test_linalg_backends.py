@@ -183,6 +183,21 @@ def test_pardiso_rejects_a_missing_diagonal_and_singular():
         get_backend("pardiso").factorize(S)
 
 
+@needs_pardiso
+def test_pardiso_refuses_non_finite_matrices_and_keeps_factorising():
+    """A tangent of NaN or infinite entries is refused by name (MKL would factorise NaN
+    into NaN solves, and crashed analysing infinite values after a NaN factorisation)."""
+    A = sp.csr_matrix(np.array([[4.0, 1.0, 0.0], [1.0, 3.0, 1.0], [0.0, 1.0, 2.0]]))
+    backend = get_backend("pardiso")
+    for bad, upper in ((np.nan, False), (np.inf, True)):
+        B = sp.triu(A, format="csr") if upper else A.copy()
+        B.data[1] = bad
+        with pytest.raises(SingularMatrixError, match="non-finite"):
+            backend.factorize(B, upper=upper)
+    b = np.ones(3)
+    np.testing.assert_allclose(backend.factorize(A).solve(b), np.linalg.solve(A.toarray(), b))
+
+
 @pytest.mark.parametrize(("given", "want"), [(None, "AUTO"), ("COMPATIBLE", "COMPATIBLE")])
 def test_pardiso_asks_mkl_for_reproducible_results(given, want):
     """MKL reads MKL_CBWR when it loads: the PARDISO backend sets it (unless the user did)
