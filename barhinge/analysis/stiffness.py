@@ -118,6 +118,9 @@ def linear_response(
     free = free_dofs(fixed, n)
     K = tangent_stiffness(model, X) if K is None else sp.csr_matrix(K)
     Kff = K[free][:, free].tocsr()
+    held = np.setdiff1d(np.arange(3 * n), free)
+    K_held = K[held]  # the reactions' rows: the rest of K is not kept beside the factor
+    del K
     try:
         # the solver's symmetric factorisation (PARDISO where installed, else SuperLU in
         # symmetric mode): a general LU of this symmetric matrix fills in several times more
@@ -140,9 +143,9 @@ def linear_response(
         )
     u = np.zeros(3 * n)
     u[free] = uf
-    R = (K @ u - f.ravel()).reshape(n, 3)
-    R[~np.asarray(fixed, bool)] = 0.0
-    return u.reshape(n, 3), R
+    R = np.zeros(3 * n)
+    R[held] = K_held @ u - f.ravel()[held]
+    return u.reshape(n, 3), R.reshape(n, 3)
 
 
 def effective_stiffness(

@@ -193,3 +193,26 @@ def test_modes_are_written_as_vtu(tmp_path):
     back = meshio.read(paths[0])
     np.testing.assert_allclose(back.points, res.X, rtol=0, atol=1e-12)
     np.testing.assert_allclose(back.point_data["mode"], res.modes[0], rtol=0, atol=1e-12)
+
+
+def test_a_large_factor_released_while_the_geometric_stiffness_is_built_changes_nothing(
+    monkeypatch,
+):
+    """Above ``RELEASE_FACTOR_ABOVE`` the stiffness's factor is freed while the geometric
+    stiffness is assembled and factorised again for the eigensolver (peak memory): the
+    buckling factors and modes are those of the one-factor route."""
+    import barhinge.analysis.buckling as buckling
+    from barhinge.linalg.backends import available_backends
+
+    if "pardiso" not in available_backends():
+        pytest.skip("the release applies to backends that report their factor's size")
+    from barhinge.linalg.backends import PardisoBackend
+
+    ref = _plate_buckling_ratio(4)
+    calls = []
+    release = PardisoBackend.release
+    monkeypatch.setattr(PardisoBackend, "release", lambda self: calls.append(release(self)))
+    monkeypatch.setattr(buckling, "RELEASE_FACTOR_ABOVE", -1)
+    released = _plate_buckling_ratio(4)
+    assert len(calls) == 1
+    assert released == pytest.approx(ref, rel=1e-10)
