@@ -33,7 +33,7 @@ from barhinge.kernels.geometry import (
     hinge_angle_gradient,
     hinge_energy_hessian_packed,
 )
-from barhinge.linalg.backends import SingularMatrixError, get_backend
+from barhinge.linalg.backends import SingularMatrixError, get_backend, refined_solve
 from barhinge.linalg.threads import threads_for_sparse
 
 __all__ = [
@@ -177,7 +177,7 @@ def linear_buckling(
         ) from exc
     du = np.zeros(3 * n)
     pf = P.ravel()[free]
-    du[free] = lu.solve(pf)
+    du[free] = refined_solve(lu, Kff, pf)[0]
     if not np.all(np.isfinite(du)):
         raise BucklingError("linear buckling: the pre-buckling solve is not finite (mechanism)")
     if np.linalg.norm(Kff @ du[free] - pf) > 1e-4 * max(float(np.linalg.norm(pf)), 1e-300):

@@ -25,7 +25,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from barhinge.errors import ConfigError
-from barhinge.linalg.backends import SingularMatrixError, get_backend
+from barhinge.linalg.backends import SingularMatrixError, get_backend, refined_solve
 from barhinge.linalg.threads import sparse_solves
 
 __all__ = [
@@ -109,7 +109,8 @@ def linear_response(
     Raises
     ------
     ConfigError
-        If the supports leave a mechanism (singular constrained tangent).
+        If the supports leave a mechanism (singular constrained tangent) or the tangent is
+        too ill-conditioned to solve (relative residual above 1e-4 after refinement).
     """
     n = model.n_nodes
     f = np.asarray(loads, float)
@@ -127,8 +128,7 @@ def linear_response(
         ff = f.ravel()[free]
         with sparse_solves():
             lu = get_backend("auto").factorize(Kff)
-            uf = lu.solve(ff)
-            uf += lu.solve(ff - Kff @ uf)  # one step of iterative refinement
+            uf, _ = refined_solve(lu, Kff, ff)
     except SingularMatrixError as exc:  # exactly singular
         raise ConfigError(
             "the supports leave a mechanism: the constrained tangent is singular "
@@ -138,8 +138,9 @@ def linear_response(
     fn = max(float(np.linalg.norm(f)), 1e-300)
     if not np.all(np.isfinite(uf)) or np.linalg.norm(res) > 1e-4 * fn:
         raise ConfigError(
-            "the supports leave a mechanism: the constrained tangent is (nearly) singular "
-            f"(relative residual {np.linalg.norm(res) / fn:.1e})"
+            "the constrained tangent is (nearly) singular: the supports leave a mechanism, "
+            "or the mesh is too fine to solve in double precision (relative residual "
+            f"{np.linalg.norm(res) / fn:.1e} after iterative refinement)"
         )
     u = np.zeros(3 * n)
     u[free] = uf
