@@ -42,7 +42,8 @@ DOC = ROOT / "docs" / "roofs.md"
 START, END = "<!-- accuracy-check:start -->", "<!-- accuracy-check:end -->"
 #: accuracies asked of the chooser, loosest first
 TARGETS = ("10%", "5%", "2%")
-#: the chooser's finest level (the refine study's budget: the same levels as its table)
+#: the chooser's finest level (the shell comparison's budget; the refine study goes one level
+#: further on the triangulated roofs, ``roofs.REFINE_STUDY_DOF_BUDGET``)
 MAX_DOFS = roofs.REFINE_DOF_BUDGET
 #: a shell reference counts when it is settled to within this (relative uncertainty)
 SHELL_TOL = 0.05

@@ -387,8 +387,16 @@ BENDING_RULES: dict[str, dict[str, Any]] = {
 
 #: a roof is refined when its stiffness changes by less than this between two levels
 REFINE_TOL = 0.02
-#: no refinement level above this many DOFs (the largest takes a few minutes and ~8 GB)
+#: no refinement level above this many DOFs in the shell comparison and the accuracy check
+#: (the largest takes a few minutes and ~6 GB)
 REFINE_DOF_BUDGET = 650_000
+#: the refinement study's budget (refine.py): one more level, m = 128 (about 1.3 M DOFs,
+#: 16 GB), on the roofs of triangular panels (Yoshimura, Resch, waterbomb). The parallelogram
+#: roofs' next level, m = 64 (1.8 to 2.4 M DOFs), is not solvable in double precision: the
+#: relative residual of its linear solve grows with the level (miura75 15: 7e-9, 6e-8, 4e-6
+#: at m = 8, 16, 32; 2e-4 at m = 64, which iterative refinement does not reduce), and
+#: :func:`barhinge.analysis.stiffness.linear_response` refuses it
+REFINE_STUDY_DOF_BUDGET = 1_400_000
 
 
 def settled(k: list[float], tol: float = REFINE_TOL) -> bool:
