@@ -487,7 +487,8 @@ def refined_solve(
 ) -> tuple[np.ndarray, float]:
     """Solve ``A x = b`` with a factor of ``A`` and iterative refinement (Wilkinson; Higham
     2002, Accuracy and Stability of Numerical Algorithms, ch. 12): corrections from the
-    residual while they shrink it by half or more, up to ``max_steps``. A factor with
+    residual, each kept where it shrinks the residual, until one shrinks it by less than half
+    or after ``max_steps``. A factor with
     perturbed pivots (PARDISO on an ill-conditioned matrix, e.g. a sheet cut into millions
     of graded cells) solves only approximately; refinement recovers the accuracy where the
     perturbation is small. Returns ``(x, |A x - b| / |b|)``."""
@@ -501,9 +502,12 @@ def refined_solve(
         x_new = x + np.asarray(factor.solve(r))
         r_new = b - A @ x_new
         rel_new = float(np.linalg.norm(r_new)) / bn
-        if not rel_new < 0.5 * rel:
+        if not rel_new < rel:  # no gain: the last solution stands
             break
+        fast = rel_new < 0.5 * rel
         x, r, rel = x_new, r_new, rel_new
+        if not fast:
+            break
     return x, rel
 
 

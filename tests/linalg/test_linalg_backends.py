@@ -307,7 +307,14 @@ def test_refined_solve_recovers_the_accuracy_of_an_inexact_factor():
     x, rel = refined_solve(near, A, b)
     np.testing.assert_allclose(x, x_true, rtol=1e-11)
     assert rel < 1e-13
-    far = SuperLUBackend().factorize(sp.csr_matrix(A * 3.0))  # |A^-1 E| = 2: diverges
+    # the factor of 3 A: each step leaves 2/3 of the residual, so one step is kept (the
+    # residual 2/3 -> 4/9 of b) and refinement stops there (less than halved)
+    far = SuperLUBackend().factorize(sp.csr_matrix(A * 3.0))
     x, rel = refined_solve(far, A, b)
-    np.testing.assert_allclose(x, np.linalg.solve(3.0 * A.toarray(), b), rtol=1e-12)
-    assert rel > 0.5
+    np.testing.assert_allclose(x, x_true * 5.0 / 9.0, rtol=1e-10)
+    assert rel == pytest.approx(4.0 / 9.0, rel=1e-10)
+    # a factor that makes things worse (of -A: the residual doubles) keeps the first solve
+    worse = SuperLUBackend().factorize(sp.csr_matrix(-A))
+    x, rel = refined_solve(worse, A, b)
+    np.testing.assert_allclose(x, -x_true, rtol=1e-10)
+    assert rel == pytest.approx(2.0, rel=1e-10)
