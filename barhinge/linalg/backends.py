@@ -487,11 +487,11 @@ def refined_solve(
 ) -> tuple[np.ndarray, float]:
     """Solve ``A x = b`` with a factor of ``A`` and iterative refinement (Wilkinson; Higham
     2002, Accuracy and Stability of Numerical Algorithms, ch. 12): corrections from the
-    residual, each kept where it shrinks the residual, until one shrinks it by less than half
-    or after ``max_steps``. A factor with
-    perturbed pivots (PARDISO on an ill-conditioned matrix, e.g. a sheet cut into millions
-    of graded cells) solves only approximately; refinement recovers the accuracy where the
-    perturbation is small. Returns ``(x, |A x - b| / |b|)``."""
+    residual, each kept where it shrinks the residual, until one shrinks it by less than
+    half or after ``max_steps``. It recovers the accuracy of a factor that solves only
+    approximately (perturbed pivots, a nearby matrix) where the error contracts; on a matrix
+    too ill-conditioned for double precision it gains little and stops. Returns
+    ``(x, |A x - b| / |b|)``."""
     x = np.asarray(factor.solve(b))
     bn = max(float(np.linalg.norm(b)), 1e-300)
     r = b - A @ x
