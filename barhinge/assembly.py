@@ -63,8 +63,8 @@ def _block_pattern(
     scipy's COO-to-CSR conversion counts the pairs into rows and merges duplicates within a
     row (a bucket sort): several times faster and smaller than ``numpy.unique`` of 64-bit
     keys on the millions of node pairs of coupled hinges."""
+    # the conversion merges duplicates and sorts each row (canonical format)
     S = sp.csr_matrix((np.ones(len(lo), bool), (lo, hi)), shape=(n_nodes, n_nodes))
-    S.sum_duplicates()
     nblk = S.nnz
     rows = np.repeat(np.arange(n_nodes, dtype=S.indices.dtype), np.diff(S.indptr))
     ordinals = sp.csr_matrix(
@@ -126,7 +126,8 @@ class Assembler:
         n_packed = sum(len(iu) * len(c) for c, (iu, _) in zip(conns, self.triu, strict=True))
 
         # 1. node-pair blocks: every element couples its node pairs (a <= b locally)
-        n_inst = sum(len(np.triu_indices(c.shape[1])[0]) * len(c) for c in conns)
+        pair_of = [np.triu_indices(c.shape[1]) for c in conns]
+        n_inst = sum(len(la) * len(c) for c, (la, _) in zip(conns, pair_of, strict=True))
         ntype = index_dtype(N)
         pairs = [_node_pairs(c, ntype) for c in conns]
         pairs += [_node_pairs(np.asarray(g), ntype) for g in pattern_groups]
@@ -141,7 +142,6 @@ class Assembler:
         # the block of every valued instance (the pattern groups' pairs come after them)
         inv = np.asarray(ordinals[lo[:n_inst], hi[:n_inst]]).ravel().astype(itype)
         del lo, hi, ordinals
-        pair_of = [np.triu_indices(c.shape[1]) for c in conns]
         self._fdofs = self._fdofs.astype(itype)
         self.dofs = [D.astype(itype) for D in self.dofs]
 
