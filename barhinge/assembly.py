@@ -19,8 +19,8 @@ entries (the 12-node hinges have 78 upper entries in 10 node pairs), at the same
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from typing import Any
+from collections.abc import Callable, Sequence
+from typing import Any, NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
@@ -36,6 +36,11 @@ ENTRY_STRUCTURES = 2
 #: 0.9 GB at 1 M DOF) is allocated by every evaluation and freed with it, so it does not
 #: stay beside the factorisation, whose memory peak sets the largest model a machine takes
 KEEP_SCRATCH_BYTES = 256 * 2**20
+#: elements per chunk of the summation into node-pair blocks: an evaluation that writes its
+#: values chunk by chunk (:meth:`Assembler.block_sums_filled`) holds one chunk's values
+#: (9 x node pairs x chunk floats: 47 MB for the hinges) where the whole array is 0.9 GB at
+#: 1 M DOF
+ASSEMBLY_CHUNK = 65536
 
 
 def element_dofs(conn: np.ndarray) -> np.ndarray:
@@ -76,6 +81,57 @@ def _block_pattern(
 
 #: component ``3 j + i`` of a 3x3 block for its component ``3 i + j`` (the transpose)
 _TRANSPOSED = np.array([0, 3, 6, 1, 4, 7, 2, 5, 8])
+
+
+class _Chunk(NamedTuple):
+    """The summation of one chunk of a group's elements into the node-pair blocks."""
+
+    start: int  # the chunk's first element in its group
+    stop: int  # one past its last
+    out: slice | np.ndarray  # the blocks it adds to: a range, or their indices where sparse
+    direct: sp.csr_matrix  # (blocks of ``out``, instances of the chunk) 0/1: as they are
+    swapped: sp.csr_matrix  # the same for the instances added transposed
+
+
+def _chunk_summation(
+    start: int,
+    stop: int,
+    block: np.ndarray,
+    swapped: np.ndarray,
+    local: np.ndarray,
+    itype: type[np.signedinteger],
+) -> _Chunk:
+    """The summation matrices of one chunk whose instances (pair-major, the chunk's elements
+    within) add to the blocks ``block``, transposed where ``swapped``. The blocks it touches
+    are addressed as one range where they fill most of it (meshes numbered along the sheet),
+    else by index; ``local`` is an ``(n_blocks,)`` scratch array of zeros (left zero)."""
+    local[block] = 1  # the touched blocks, found without sorting
+    touched = np.flatnonzero(local)
+    local[touched] = 0
+    lo, hi = int(touched[0]), int(touched[-1]) + 1
+    if hi - lo <= 4 * len(touched):
+        out: slice | np.ndarray = slice(lo, hi)
+        rows = (block - lo).astype(itype)
+        n_rows = hi - lo
+    else:
+        out = touched.astype(itype)
+        local[touched] = np.arange(len(touched), dtype=itype)
+        rows = local[block]
+        local[touched] = 0
+        n_rows = len(touched)
+
+    def summation(mask: np.ndarray) -> sp.csr_matrix:
+        cols = np.flatnonzero(mask).astype(itype)
+        S = sp.csr_matrix((np.ones(len(cols)), (rows[cols], cols)), shape=(n_rows, len(block)))
+        return S
+
+    return _Chunk(start, stop, out, summation(~swapped), summation(swapped))
+
+
+def _add_chunk(sums: np.ndarray, V: np.ndarray, chunk: _Chunk) -> None:
+    """Add the ``(9, instances)`` values ``V`` of one chunk into the block sums."""
+    for c in range(9):
+        sums[c, chunk.out] += chunk.direct @ V[c] + chunk.swapped @ V[_TRANSPOSED[c]]
 
 
 class PackedRows:
@@ -166,21 +222,18 @@ class Assembler:
             off += npair * ne
         self.n_instances = n_inst
 
-        def summation(mask: np.ndarray, block: np.ndarray) -> sp.csr_matrix:
-            """(blocks, instances) 0/1 CSR adding the instances ``mask`` to their blocks
-            (``block``: the block of every instance)."""
-            inst = np.flatnonzero(mask).astype(itype)
-            rows = block[inst]
-            order = inst[np.argsort(rows, kind="stable")]
-            indptr = np.zeros(nblk + 1, itype)
-            np.cumsum(np.bincount(rows, minlength=nblk), out=indptr[1:])
-            S = sp.csr_matrix((np.ones(len(inst)), order, indptr), shape=(nblk, n_inst), copy=False)
-            S.has_sorted_indices = False
-            return S
-
-        self._sum_direct = summation(~swapped, inv)
-        self._sum_swapped = summation(swapped, inv)
-        del swapped, inv
+        # the summation matrices chunk by chunk of elements (ASSEMBLY_CHUNK per chunk): an
+        # evaluation needs the values of one chunk at a time (block_sums_filled)
+        local = np.zeros(nblk, itype)  # scratch of _chunk_summation
+        self._chunks: list[list[_Chunk]] = []
+        for off, npair, ne, _, _ in self._layout:
+            chunks = []
+            for e0 in range(0, ne, ASSEMBLY_CHUNK):
+                e1 = min(e0 + ASSEMBLY_CHUNK, ne)
+                inst = (off + np.arange(npair)[:, None] * ne + np.arange(e0, e1)[None, :]).ravel()
+                chunks.append(_chunk_summation(e0, e1, inv[inst], swapped[inst], local, itype))
+            self._chunks.append(chunks)
+        del swapped, inv, local
         self._n_blocks = nblk
 
         # 3. full symmetric CSR pattern from the blocks, and the gather from the block sums
@@ -229,8 +282,11 @@ class Assembler:
         """Bytes held by the scatter maps and the pattern (bytes; the scratch buffer of
         :meth:`value_buffers` excluded)."""
         arrays = [self._fdofs, self._gather, self.indices, self.indptr, *self.dofs]
-        for S in (self._sum_direct, self._sum_swapped):
-            arrays += [S.data, S.indices, S.indptr]
+        for chunk in (c for group in self._chunks for c in group):
+            for S in (chunk.direct, chunk.swapped):
+                arrays += [S.data, S.indices, S.indptr]
+            if isinstance(chunk.out, np.ndarray):
+                arrays.append(chunk.out)
         return int(sum(a.nbytes for a in arrays))
 
     def __getstate__(self) -> dict:
@@ -241,9 +297,17 @@ class Assembler:
 
     def force(self, element_vectors: list[np.ndarray]) -> np.ndarray:
         """(n_dof,) sum of entry-major element vectors ``(3 * nodes, n_el)`` of each group
-        (the first groups, in order: groups left out contribute nothing)."""
-        val = np.concatenate([f.ravel() for f in element_vectors])
-        return np.bincount(self._fdofs[: len(val)], weights=val, minlength=self.n_dof)
+        (the first groups, in order: groups left out contribute nothing), group by group
+        (no concatenated copy of the element vectors)."""
+        out = np.zeros(self.n_dof)
+        start = 0
+        for f in element_vectors:
+            val = f.ravel()
+            out += np.bincount(
+                self._fdofs[start : start + len(val)], weights=val, minlength=self.n_dof
+            )
+            start += len(val)
+        return out
 
     def _group_views(self, flat: np.ndarray) -> list[PackedRows]:
         """The packed rows of every group in the block-layout array ``flat``."""
@@ -294,9 +358,32 @@ class Assembler:
         Between the two the caller can drop the value array (about 0.9 GB at 1 M DOF), so
         that it is not held beside the matrix's values."""
         V = flat.reshape(9, self.n_instances)
-        sums = np.empty((9, self._n_blocks))
-        for c in range(9):
-            np.add(self._sum_direct @ V[c], self._sum_swapped @ V[_TRANSPOSED[c]], out=sums[c])
+        sums = np.zeros((9, self._n_blocks))
+        for (off, npair, ne, _, _), chunks in zip(self._layout, self._chunks, strict=True):
+            Vg = V[:, off : off + npair * ne].reshape(9, npair, ne)
+            for chunk in chunks:  # a copy of the chunk's values where it is not the group
+                _add_chunk(sums, Vg[:, :, chunk.start : chunk.stop].reshape(9, -1), chunk)
+        return sums
+
+    def block_sums_filled(self, fill: Callable[[int, slice, PackedRows], None]) -> np.ndarray:
+        """(9, n_blocks) block sums (as :meth:`block_sums`) of element values written chunk
+        by chunk: ``fill(g, sl, rows)`` writes the packed rows (:meth:`value_buffers`'
+        layout) of the elements ``sl`` (a slice) of group ``g`` into ``rows``, the
+        :class:`PackedRows` of a scratch buffer of those elements only, and must write every
+        packed row. At most ``ASSEMBLY_CHUNK`` elements' values exist at a time (the whole
+        array would be about 0.9 GB at 1 M DOF, beside a held factorisation)."""
+        sums = np.zeros((9, self._n_blocks))
+        groups = zip(self._layout, self._chunks, strict=True)
+        for g, ((_, npair, ne, comp, pair), chunks) in enumerate(groups):
+            full = min(ne, ASSEMBLY_CHUNK)
+            scratch = np.zeros(9 * npair * full)  # the lower diagonal components stay 0
+            for chunk in chunks:
+                n = chunk.stop - chunk.start
+                buf = scratch[: 9 * npair * n].reshape(9, npair, n)
+                if n < full:  # the last chunk, laid out shorter: no stale value stays
+                    buf[...] = 0.0
+                fill(g, slice(chunk.start, chunk.stop), PackedRows(buf, comp, pair))
+                _add_chunk(sums, buf.reshape(9, -1), chunk)
         return sums
 
     def matrix_from_sums(self, sums: np.ndarray) -> sp.csr_matrix:

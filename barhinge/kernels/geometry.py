@@ -366,7 +366,13 @@ def hinge_angle_hessian_packed(
 
 
 def hinge_energy_hessian_packed(
-    X: np.ndarray, hinges: np.ndarray, law, out: Any = None, chunk: int = 8192
+    X: np.ndarray,
+    hinges: np.ndarray,
+    law,
+    out: Any = None,
+    chunk: int = 8192,
+    start: int = 0,
+    XT: np.ndarray | None = None,
 ):
     """Fast path of the assembly: hinge energy derivatives, component-major.
 
@@ -379,6 +385,10 @@ def hinge_energy_hessian_packed(
         hinges ``sl`` (the assembler's :class:`~barhinge.assembly.PackedRows`)
     chunk : hinges per pass (keeps the working vectors in cache; a loop over chunks, not
         elements)
+    start : the position of ``hinges[0]`` among the model's hinges (the law's slices are
+        shifted by it: ``hinges`` may be a part of the model's)
+    XT : optional ``X.T`` as a C-contiguous (3, n_nodes) array (saves the copy of a caller
+        that passes the hinges part by part)
 
     Returns
     -------
@@ -386,12 +396,13 @@ def hinge_energy_hessian_packed(
     energy Hessian ``M d2rho/dX2 + Kt grad grad^T`` (78, nh) in ``TRIU12`` order.
     """
     nh = len(hinges)
-    XT = np.ascontiguousarray(X.T)
+    XT = np.ascontiguousarray(X.T) if XT is None else XT
     Hp = np.empty((78, nh)) if out is None else out
     grad = np.empty((12, nh))
     rho, M, Kt, W = (np.empty(nh) for _ in range(4))
     for s0 in range(0, nh, chunk):
         sl = slice(s0, min(s0 + chunk, nh))
-        r, g, _, (m, k, e) = _hinge_hessian_packed_t(XT, hinges[sl], law, sl, Hp[:, sl])
+        in_model = slice(start + sl.start, start + sl.stop)
+        r, g, _, (m, k, e) = _hinge_hessian_packed_t(XT, hinges[sl], law, in_model, Hp[:, sl])
         rho[sl], grad[:, sl], M[sl], Kt[sl], W[sl] = r, g, m, k, e
     return rho, M, Kt, W, grad, Hp

@@ -22,7 +22,7 @@ import scipy.sparse as sp
 
 from barhinge import _check
 from barhinge._typing import SCHEMES, Scheme, StrainMeasure
-from barhinge.assembly import Assembler
+from barhinge.assembly import Assembler, PackedRows
 from barhinge.errors import ConfigError
 from barhinge.kernels.geometry import (
     bar_strain,
@@ -554,34 +554,43 @@ class BarHingeModel:
         law = self._hinge_law
         if len(self.hinge_pairs):
             law = functools.partial(law, pair_moment=self._pair_moment(hinge_angle(X, hinges)))
-        if tangent:
-            flat, (Kb, Hp) = asm.value_buffers()
-            # g (12, nh), Hp (78, nh): packed upper triangle of the hinge energy Hessian
-            rho, M, Kt, Wh, g, Hp = hinge_energy_hessian_packed(X, hinges, law, Hp)
-        else:
-            rho, g = hinge_angle_gradient_t(X, hinges)
-            M, Kt, Wh = self._hinge_law(rho)
-        force = asm.force([fe_bar, M * g])
         K = None
         if tangent:
-            # bar: [[k, -k], [-k, k]] with k = S'' d d^T + S B, packed upper triangle of 6x6;
-            # the 6 distinct entries of the symmetric 3x3 k, component-major
+            nh = len(hinges)
+            rho, M, Kt, Wh = (np.empty(nh) for _ in range(4))
+            g = np.empty((12, nh))
+            XT = np.ascontiguousarray(X.T)
             dT = np.ascontiguousarray(d.T)
-            for q, (a, b) in enumerate(_SYM3):
-                row = Kb[_BAR_FIRST[q]]
-                np.multiply(dS * dT[a], dT[b], out=row)
-                row += S * B[:, a, b]
-            for p_, (q, sgn) in enumerate(zip(_BAR_Q, _BAR_SIGN, strict=True)):
-                if p_ != _BAR_FIRST[q]:
-                    np.multiply(Kb[_BAR_FIRST[q]], sgn, out=Kb[p_])
-            sums = asm.block_sums(flat)
-            del flat, Kb, Hp  # a value buffer not kept by the assembler is freed here
+
+            def fill(group: int, sl: slice, rows: PackedRows) -> None:
+                """The packed upper triangles of the elements ``sl`` of a group."""
+                if group == 0:
+                    # bar: [[k, -k], [-k, k]] with k = S'' d d^T + S B, packed upper
+                    # triangle of 6x6; the 6 distinct entries of the symmetric 3x3 k
+                    for q, (a, b) in enumerate(_SYM3):
+                        row = rows[_BAR_FIRST[q]]
+                        np.multiply(dS[sl] * dT[a, sl], dT[b, sl], out=row)
+                        row += S[sl] * B[sl, a, b]
+                    for p_, (q, sgn) in enumerate(zip(_BAR_Q, _BAR_SIGN, strict=True)):
+                        if p_ != _BAR_FIRST[q]:
+                            np.multiply(rows[_BAR_FIRST[q]], sgn, out=rows[p_])
+                else:  # g (12, nh), packed upper triangle (78, nh) of the hinge Hessian
+                    out = hinge_energy_hessian_packed(
+                        X, hinges[sl], law, rows, start=sl.start, XT=XT
+                    )
+                    rho[sl], M[sl], Kt[sl], Wh[sl], g[:, sl] = out[:5]
+
+            sums = asm.block_sums_filled(fill)  # one chunk of element values at a time
             K = asm.matrix_from_sums(sums)
             del sums
             if len(self.hinge_pairs):
                 self._add_pair_tangent(K, g)
             if len(self.bar_pairs):
                 self._add_bar_pair_tangent(K, d)
+        else:
+            rho, g = hinge_angle_gradient_t(X, hinges)
+            M, Kt, Wh = self._hinge_law(rho)
+        force = asm.force([fe_bar, np.multiply(g, M, out=g)])  # g is not needed after this
         f = self._is_fold
         return Evaluation(
             energy_bars=float(Wb.sum()),

@@ -67,6 +67,45 @@ def test_assembly_equals_element_by_element_oracle(mi: int) -> None:
     assert np.abs(m.internal_force(X) - ev.force).max() <= 1e-13 * np.abs(ev.force).max()
 
 
+@pytest.mark.parametrize("mi", range(len(MODELS) + 1))
+def test_an_evaluation_in_chunks_of_three_elements_is_the_one_in_a_single_chunk(
+    mi: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The evaluation writes its element values chunk by chunk (``ASSEMBLY_CHUNK``); with
+    chunks of three elements the hinge laws that read their hinges' slice (per-hinge
+    penetration limits) and the hinge couplings (the last case) still get their own hinges:
+    the same energy, force and tangent as the oracle and as one chunk per group."""
+    import barhinge.assembly as assembly
+
+    def build() -> BarHingeModel:
+        if mi < len(MODELS):
+            return models()[mi]
+        m = BarHingeModel.from_pattern(bh.families.miura(2, 2, fold=30.0), "N5B8", MAT)
+        h = [set(x) for x in np.asarray(m.hinges)]
+        near = [(i, j) for i in range(len(h)) for j in range(i + 1, len(h)) if h[i] & h[j]]
+        pairs = np.array(near[:: max(1, len(near) // 30)])
+        k = np.random.default_rng(2).uniform(-0.5, 0.5, len(pairs))
+        return m.with_(hinge_pairs=pairs, pair_k=k)
+
+    whole = build()
+    X = perturbed(whole, 20 + mi)
+    ref = whole.evaluate(X)
+    monkeypatch.setattr(assembly, "ASSEMBLY_CHUNK", 3)
+    m = build()
+    assert max(len(group) for group in m.assembler._chunks) > 1
+    ev = m.evaluate(X)
+    assert ev.energy == pytest.approx(ref.energy, rel=1e-13)
+    assert np.abs(ev.force - ref.force).max() <= 1e-13 * np.abs(ref.force).max()
+    assert np.abs(ev.K.toarray() - ref.K.toarray()).max() <= 1e-13 * abs(ref.K).max()
+    if mi < len(MODELS):
+        E, f, K = assemble_reference(m, X)
+        assert ev.energy == pytest.approx(E, rel=1e-12)
+        assert np.abs(ev.force - f).max() <= 1e-12 * np.abs(f).max()
+        assert np.abs(ev.K.toarray() - K).max() <= 1e-12 * np.abs(K).max()
+    else:
+        assert len(m.hinge_pairs) > 10
+
+
 @pytest.mark.parametrize("mi", range(len(MODELS)))
 def test_assembled_force_and_tangent_match_fd_of_energy(mi: int) -> None:
     """Central differences of the assembled energy / force along random directions; relative
@@ -312,9 +351,61 @@ def test_block_layout_rows_and_packed_lists_assemble_the_same_dense_sum() -> Non
     assert np.abs(K_list - dense).max() <= 1e-13 * np.abs(dense).max()
     assert np.array_equal(K_rows, K_list) and np.array_equal(K_list, K_list.T)
     pairs = sum(len(c) * c.shape[1] * (c.shape[1] + 1) // 2 for c in groups)
-    assert asm._sum_direct.nnz + asm._sum_swapped.nnz == pairs
+    chunks = [c for group in asm._chunks for c in group]
+    assert sum(c.direct.nnz + c.swapped.nnz for c in chunks) == pairs
     with pytest.raises(ValueError, match="flat value array"):
         asm.matrix_packed(np.zeros(5))
+
+
+@pytest.mark.parametrize("chunk", [1, 4, 7, 65536])
+def test_element_values_written_chunk_by_chunk_sum_to_the_dense_sum(
+    chunk: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``block_sums_filled`` (an evaluation's path: one chunk of elements' values at a time)
+    and ``block_sums`` of the whole value array give the dense sum written here, with chunks
+    of one element, chunks whose last is shorter, and one chunk per group; the elements'
+    nodes at random (their blocks addressed by index) and numbered along a strip (a range)."""
+    import barhinge.assembly as assembly
+    from barhinge.assembly import Assembler, element_dofs
+
+    monkeypatch.setattr(assembly, "ASSEMBLY_CHUNK", chunk)
+    rng = np.random.default_rng(5)
+    n_nodes = 40
+    scattered = [rng.permuted(np.tile(np.arange(n_nodes), (30, 1)), axis=1)[:, :k] for k in (2, 4)]
+    strip = [np.arange(k)[None, :] + np.arange(n_nodes - 4)[:, None] for k in (2, 4)]
+    for groups in (scattered, strip):
+        asm = Assembler(n_nodes, groups)
+        kinds = {isinstance(c.out, slice) for group in asm._chunks for c in group}
+        dense = np.zeros((3 * n_nodes, 3 * n_nodes))
+        packed = []
+        for conn in groups:
+            m = 3 * conn.shape[1]
+            A = rng.normal(size=(len(conn), m, m))
+            Ke = A + A.transpose(0, 2, 1)
+            for dofs, k in zip(element_dofs(conn), Ke, strict=True):
+                dense[np.ix_(dofs, dofs)] += k
+            iu, ju = np.triu_indices(m)
+            packed.append(Ke[:, iu, ju].T)
+        calls = []
+
+        def fill(g: int, sl: slice, rows, calls=calls, packed=packed) -> None:
+            calls.append((g, sl.start, sl.stop))
+            for p in range(len(packed[g])):
+                rows[p][...] = packed[g][p, sl]
+
+        K_filled = asm.matrix_from_sums(asm.block_sums_filled(fill)).toarray()
+        assert calls == [
+            (g, s0, min(s0 + chunk, len(c))) for g, c in enumerate(groups)
+            for s0 in range(0, len(c), chunk)
+        ]  # fmt: skip
+        K_whole = asm.matrix_packed(packed).toarray()
+        for K in (K_filled, K_whole):
+            assert np.abs(K - dense).max() <= 1e-13 * np.abs(dense).max()
+            assert np.array_equal(K, K.T)
+        if groups is strip:
+            assert kinds == {True}  # numbered along the strip: every chunk a range
+        elif chunk <= 4:
+            assert False in kinds  # scattered: some chunk addressed by index
 
 
 def test_value_buffer_above_the_kept_size_is_new_at_every_evaluation(
