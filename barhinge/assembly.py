@@ -128,6 +128,13 @@ def _chunk_summation(
     return _Chunk(start, stop, out, summation(~swapped), summation(swapped))
 
 
+def _with_data(S: sp.csr_matrix, ones: np.ndarray) -> sp.csr_matrix:
+    """The 0/1 matrix ``S`` with its values a view of ``ones`` (shared by every chunk)."""
+    out = sp.csr_matrix((ones[: S.nnz], S.indices, S.indptr), shape=S.shape, copy=False)
+    out.has_canonical_format = True
+    return out
+
+
 def _add_chunk(sums: np.ndarray, V: np.ndarray, chunk: _Chunk) -> None:
     """Add the ``(9, instances)`` values ``V`` of one chunk into the block sums."""
     for c in range(9):
@@ -199,7 +206,12 @@ class Assembler:
         inv = np.asarray(ordinals[lo[:n_inst], hi[:n_inst]]).ravel().astype(itype)
         del lo, hi, ordinals
         self._fdofs = self._fdofs.astype(itype)
-        self.dofs = [D.astype(itype) for D in self.dofs]
+        # the per-group (n_el, 3 * nodes) dofs: views of the entry-major force map (one copy)
+        views, start = [], 0
+        for D in self.dofs:
+            views.append(self._fdofs[start : start + D.size].reshape(D.shape[1], D.shape[0]).T)
+            start += D.size
+        self.dofs = views
 
         # 2. the block layout of the element values and its 0/1 summation matrices: every
         #    element node pair (an *instance*, pair-major, the elements within) adds its 3x3
@@ -234,6 +246,19 @@ class Assembler:
                 chunks.append(_chunk_summation(e0, e1, inv[inst], swapped[inst], local, itype))
             self._chunks.append(chunks)
         del swapped, inv, local
+        # every summation's values are ones: views of one array (not a copy per chunk)
+        most = max((S.nnz for g in self._chunks for c in g for S in c[3:]), default=0)
+        self._ones = np.ones(most)
+        self._chunks = [
+            [
+                c._replace(
+                    direct=_with_data(c.direct, self._ones),
+                    swapped=_with_data(c.swapped, self._ones),
+                )
+                for c in group
+            ]
+            for group in self._chunks
+        ]
         self._n_blocks = nblk
 
         # 3. full symmetric CSR pattern from the blocks, and the gather from the block sums
@@ -281,10 +306,10 @@ class Assembler:
     def nbytes(self) -> int:
         """Bytes held by the scatter maps and the pattern (bytes; the scratch buffer of
         :meth:`value_buffers` excluded)."""
-        arrays = [self._fdofs, self._gather, self.indices, self.indptr, *self.dofs]
+        arrays = [self._fdofs, self._gather, self.indices, self.indptr, self._ones]
         for chunk in (c for group in self._chunks for c in group):
             for S in (chunk.direct, chunk.swapped):
-                arrays += [S.data, S.indices, S.indptr]
+                arrays += [S.indices, S.indptr]  # their data: views of self._ones
             if isinstance(chunk.out, np.ndarray):
                 arrays.append(chunk.out)
         return int(sum(a.nbytes for a in arrays))

@@ -548,8 +548,6 @@ class BarHingeModel:
         bars, hinges = self.bars, self.hinges
         eps, d, B = bar_strain_derivatives(X, bars, self.bar_L0, self.strain)
         S, dS, Wb = self.bar_law(eps)
-        fb = (S[:, None] * d).T  # (3, nb)
-        fe_bar = np.concatenate([-fb, fb], axis=0)
         asm = self.assembler
         law = self._hinge_law
         if len(self.hinge_pairs):
@@ -581,6 +579,7 @@ class BarHingeModel:
                     rho[sl], M[sl], Kt[sl], Wh[sl], g[:, sl] = out[:5]
 
             sums = asm.block_sums_filled(fill)  # one chunk of element values at a time
+            del B, XT, dT  # not held beside the tangent's values
             K = asm.matrix_from_sums(sums)
             del sums
             if len(self.hinge_pairs):
@@ -590,6 +589,8 @@ class BarHingeModel:
         else:
             rho, g = hinge_angle_gradient_t(X, hinges)
             M, Kt, Wh = self._hinge_law(rho)
+        fb = (S[:, None] * d).T  # (3, nb)
+        fe_bar = np.concatenate([-fb, fb], axis=0)
         force = asm.force([fe_bar, np.multiply(g, M, out=g)])  # g is not needed after this
         f = self._is_fold
         return Evaluation(
