@@ -321,17 +321,14 @@ def test_hinge_couplings_keep_the_scatter_maps_small() -> None:
     assert b.nbytes <= a.nbytes + 12 * (b.nnz - a.nnz)
 
 
-def test_block_layout_rows_and_packed_lists_assemble_the_same_dense_sum() -> None:
-    """The assembler's block layout against a dense sum written here: random symmetric element
-    matrices on elements whose node order is both ascending and descending (the swapped
-    node pairs add their blocks transposed), given as packed lists and written row by row
-    through ``value_buffers``; the maps hold one entry per node pair of an element."""
-    from barhinge.assembly import Assembler, element_dofs
+def _random_element_matrices(
+    groups: list[np.ndarray], n_nodes: int, rng: np.random.Generator
+) -> tuple[np.ndarray, list[np.ndarray]]:
+    """Random symmetric element matrices on the groups' elements: their dense sum (written
+    entry by entry) and their packed upper triangles, one ``(m (m + 1) / 2, n_el)`` array
+    per group."""
+    from barhinge.assembly import element_dofs
 
-    rng = np.random.default_rng(7)
-    n_nodes = 9
-    groups = [rng.permuted(np.tile(np.arange(n_nodes), (6, 1)), axis=1)[:, :k] for k in (2, 4)]
-    asm = Assembler(n_nodes, groups)
     dense = np.zeros((3 * n_nodes, 3 * n_nodes))
     packed = []
     for conn in groups:
@@ -342,6 +339,21 @@ def test_block_layout_rows_and_packed_lists_assemble_the_same_dense_sum() -> Non
             dense[np.ix_(dofs, dofs)] += k
         iu, ju = np.triu_indices(m)
         packed.append(Ke[:, iu, ju].T)
+    return dense, packed
+
+
+def test_block_layout_rows_and_packed_lists_assemble_the_same_dense_sum() -> None:
+    """The assembler's block layout against a dense sum written here: random symmetric element
+    matrices on elements whose node order is both ascending and descending (the swapped
+    node pairs add their blocks transposed), given as packed lists and written row by row
+    through ``value_buffers``; the maps hold one entry per node pair of an element."""
+    from barhinge.assembly import Assembler
+
+    rng = np.random.default_rng(7)
+    n_nodes = 9
+    groups = [rng.permuted(np.tile(np.arange(n_nodes), (6, 1)), axis=1)[:, :k] for k in (2, 4)]
+    asm = Assembler(n_nodes, groups)
+    dense, packed = _random_element_matrices(groups, n_nodes, rng)
     K_list = asm.matrix_packed(packed).toarray()
     flat, views = asm.value_buffers()
     for view, P in zip(views, packed, strict=True):
@@ -366,7 +378,7 @@ def test_element_values_written_chunk_by_chunk_sum_to_the_dense_sum(
     of one element, chunks whose last is shorter, and one chunk per group; the elements'
     nodes at random (their blocks addressed by index) and numbered along a strip (a range)."""
     import barhinge.assembly as assembly
-    from barhinge.assembly import Assembler, element_dofs
+    from barhinge.assembly import Assembler
 
     monkeypatch.setattr(assembly, "ASSEMBLY_CHUNK", chunk)
     rng = np.random.default_rng(5)
@@ -376,16 +388,7 @@ def test_element_values_written_chunk_by_chunk_sum_to_the_dense_sum(
     for groups in (scattered, strip):
         asm = Assembler(n_nodes, groups)
         kinds = {isinstance(c.out, slice) for group in asm._chunks for c in group}
-        dense = np.zeros((3 * n_nodes, 3 * n_nodes))
-        packed = []
-        for conn in groups:
-            m = 3 * conn.shape[1]
-            A = rng.normal(size=(len(conn), m, m))
-            Ke = A + A.transpose(0, 2, 1)
-            for dofs, k in zip(element_dofs(conn), Ke, strict=True):
-                dense[np.ix_(dofs, dofs)] += k
-            iu, ju = np.triu_indices(m)
-            packed.append(Ke[:, iu, ju].T)
+        dense, packed = _random_element_matrices(groups, n_nodes, rng)
         calls = []
 
         def fill(g: int, sl: slice, rows, calls=calls, packed=packed) -> None:
