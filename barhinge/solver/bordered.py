@@ -625,6 +625,9 @@ class BorderedSystem:
         # saddle-point backends take the upper triangle (``upper``)
         factorize: Any = self.backend.factorize
         schur = {"schur": self.Gf.shape[0]} if self._schur_counts else {}
+        # the last operator's values (kept for its released count) are not held through
+        # the factorisation's own peak (242 MB at the 1 M DOFs of a 200 x 200 Miura)
+        self._released = None
         self.factor = factorize(self._kkt_matrix(upper=True), upper=True, **schur)
         self.timer.factorize += time.perf_counter() - t_start
         self.timer.n_factorizations += 1
@@ -632,7 +635,6 @@ class BorderedSystem:
         if perturbed is not None and perturbed() > 0:
             return False
         self._keep(_KKTSolver(self.factor, self.Gf, self.penalty), t_start)
-        self._released = None
         if self._blk_ok and self._penalty_blocks is not None and self._values is not None:
             self._released = (self._values, self._blocks - self._penalty_blocks)
         return True
