@@ -12,9 +12,12 @@ Only the upper triangle (diagonal included) of each symmetric element matrix is 
 evaluation sums the instances into the node-pair blocks of the global upper triangle with two
 0/1 summation matrices (one per orientation of the pair: an instance whose first node is the
 larger adds its block transposed), nine sparse products each, and mirrors the sums into the
-full matrix by one gather; the global matrix is exactly symmetric. The maps hold one entry
-per node pair of an element, not per matrix entry: 7 to 8 times smaller than a map of the
-entries (the 12-node hinges have 78 upper entries in 10 node pairs), at the same speed.
+full matrix by one gather; the global matrix is exactly symmetric. The summation matrices are
+kept per chunk of ``ASSEMBLY_CHUNK`` elements, so an evaluation can write and sum one chunk's
+values at a time (:meth:`Assembler.block_sums_filled`) and never hold the whole value array.
+The maps hold one entry per node pair of an element, not per matrix entry: 7 to 8 times
+smaller than a map of the entries (the 12-node hinges have 78 upper entries in 10 node
+pairs), at the same speed.
 """
 
 from __future__ import annotations
