@@ -103,11 +103,13 @@ def _chunk_summation(
     swapped: np.ndarray,
     local: np.ndarray,
     itype: type[np.signedinteger],
+    ones: np.ndarray,
 ) -> _Chunk:
     """The summation matrices of one chunk whose instances (pair-major, the chunk's elements
     within) add to the blocks ``block``, transposed where ``swapped``. The blocks it touches
     are addressed as one range where they fill most of it (meshes numbered along the sheet),
-    else by index; ``local`` is an ``(n_blocks,)`` scratch array of zeros (left zero)."""
+    else by index; ``local`` is an ``(n_blocks,)`` scratch array of zeros (left zero); the
+    matrices' values are views of ``ones`` (at least as long as ``block``)."""
     local[block] = 1  # the touched blocks, found without sorting
     touched = np.flatnonzero(local)
     local[touched] = 0
@@ -125,17 +127,11 @@ def _chunk_summation(
 
     def summation(mask: np.ndarray) -> sp.csr_matrix:
         cols = np.flatnonzero(mask).astype(itype)
-        S = sp.csr_matrix((np.ones(len(cols)), (rows[cols], cols)), shape=(n_rows, len(block)))
+        S = sp.csr_matrix((ones[: len(cols)], (rows[cols], cols)), shape=(n_rows, len(block)))
+        S.data = ones[: S.nnz]  # the conversion copied its values: a view of ``ones`` instead
         return S
 
     return _Chunk(start, stop, out, summation(~swapped), summation(swapped))
-
-
-def _with_data(S: sp.csr_matrix, ones: np.ndarray) -> sp.csr_matrix:
-    """The 0/1 matrix ``S`` with its values a view of ``ones`` (shared by every chunk)."""
-    out = sp.csr_matrix((ones[: S.nnz], S.indices, S.indptr), shape=S.shape, copy=False)
-    out.has_canonical_format = True
-    return out
 
 
 def _add_chunk(sums: np.ndarray, V: np.ndarray, chunk: _Chunk) -> None:
@@ -239,29 +235,23 @@ class Assembler:
 
         # the summation matrices chunk by chunk of elements (ASSEMBLY_CHUNK per chunk): an
         # evaluation needs the values of one chunk at a time (block_sums_filled)
+        # (every summation's values are ones: views of one array, not a copy per chunk)
         local = np.zeros(nblk, itype)  # scratch of _chunk_summation
+        most = max(
+            (npair * min(ne, ASSEMBLY_CHUNK) for _, npair, ne, _, _ in self._layout), default=0
+        )
+        self._ones = np.ones(most)
         self._chunks: list[list[_Chunk]] = []
         for off, npair, ne, _, _ in self._layout:
             chunks = []
             for e0 in range(0, ne, ASSEMBLY_CHUNK):
                 e1 = min(e0 + ASSEMBLY_CHUNK, ne)
                 inst = (off + np.arange(npair)[:, None] * ne + np.arange(e0, e1)[None, :]).ravel()
-                chunks.append(_chunk_summation(e0, e1, inv[inst], swapped[inst], local, itype))
+                chunks.append(
+                    _chunk_summation(e0, e1, inv[inst], swapped[inst], local, itype, self._ones)
+                )
             self._chunks.append(chunks)
         del swapped, inv, local
-        # every summation's values are ones: views of one array (not a copy per chunk)
-        most = max((S.nnz for g in self._chunks for c in g for S in c[3:]), default=0)
-        self._ones = np.ones(most)
-        self._chunks = [
-            [
-                c._replace(
-                    direct=_with_data(c.direct, self._ones),
-                    swapped=_with_data(c.swapped, self._ones),
-                )
-                for c in group
-            ]
-            for group in self._chunks
-        ]
         self._n_blocks = nblk
 
         # 3. full symmetric CSR pattern from the blocks, and the gather from the block sums

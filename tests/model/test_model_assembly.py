@@ -365,6 +365,9 @@ def test_block_layout_rows_and_packed_lists_assemble_the_same_dense_sum() -> Non
     pairs = sum(len(c) * c.shape[1] * (c.shape[1] + 1) // 2 for c in groups)
     chunks = [c for group in asm._chunks for c in group]
     assert sum(c.direct.nnz + c.swapped.nnz for c in chunks) == pairs
+    # the summations' values are views of one array of ones (what ``nbytes`` counts once)
+    matrices = [S for c in chunks for S in (c.direct, c.swapped) if S.nnz]
+    assert all(np.shares_memory(S.data, asm._ones) for S in matrices)
     with pytest.raises(ValueError, match="flat value array"):
         asm.matrix_packed(np.zeros(5))
 
