@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
+from barhinge.analysis.stiffness import make_room_for_factor
 from barhinge.errors import BucklingError, ConfigError
 from barhinge.kernels.geometry import (
     bar_strain_derivatives,
@@ -169,6 +170,7 @@ def linear_buckling(
     if len(free) < 2:
         raise ConfigError("linear buckling needs at least two free DOFs")
     Kff = sp.csr_matrix(model.tangent(X)[free][:, free])  # the full tangent is not kept
+    make_room_for_factor(model)
     backend = get_backend("auto")
     try:
         lu = backend.factorize(Kff)  # symmetric: PARDISO, else SuperLU
@@ -207,6 +209,7 @@ def linear_buckling(
     A = geometric_stiffness(model, X, dS, dM)[free][:, free]
     A.data *= -1.0
     if release:  # numeric only: the ordering is kept
+        make_room_for_factor(model)
         lu = backend.factorize(Kff)
     k = min(int(n_modes), len(free) - 1)
     Kinv = spla.LinearOperator(Kff.shape, matvec=lu.solve, dtype=float)

@@ -434,6 +434,14 @@ class BarHingeModel:
         pairs = [pair_nodes(self.hinges, self.hinge_pairs)] if len(self.hinge_pairs) else []
         return Assembler(self.n_nodes, [self.bars, self.hinges], pattern_groups=pairs)
 
+    def release_assembler(self) -> int:
+        """Drop the cached :attr:`assembler` (its scatter maps and pattern); the next
+        evaluation builds it again. For a linear analysis of a large model that needs no
+        more tangents, this frees the maps before its factorisation. Returns the bytes the
+        maps held (0 when none were built)."""
+        asm = self.__dict__.pop("assembler", None)
+        return 0 if asm is None else asm.nbytes
+
     @cached_property
     def _pair_C(self) -> sp.csr_matrix:
         return pair_matrix(self.n_hinges, np.asarray(self.hinge_pairs), np.asarray(self.pair_k))

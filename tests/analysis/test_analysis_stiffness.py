@@ -198,3 +198,51 @@ def test_mechanism_is_reported():
     F[-1, 2] = -1.0
     with pytest.raises(ConfigError, match="mechanism"):
         effective_stiffness(model, F, fixed)
+
+
+def test_a_linear_analysis_that_drops_the_assembler_returns_the_same_response(monkeypatch):
+    """With the release threshold at zero, ``linear_response`` frees the model's assembler
+    before it factorises: the displacements and reactions are those computed with it kept
+    (bit for bit: the same tangent, the same factorisation), the next evaluation builds the
+    assembler again and gives the same tangent."""
+    import barhinge.analysis.stiffness as stiffness
+
+    L, b, q = 10.0, 1.0, 2.0
+    mat = bh.Material(E=1e6, nu=NU, t=0.01)
+    cp = grid_sheet(6, 2, lambda u, v: np.column_stack([u * L, v * b, 0.3 * np.sin(np.pi * u)]))
+    model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=mat)
+    fixed, _ = _simply_supported(model, L, diaphragm=True)
+    F = self_weight(model, q, g=(0.0, 0.0, -1.0))
+    K0 = tangent_stiffness(model)
+    U0, R0 = stiffness.linear_response(model, F, fixed)
+    assert "assembler" in model.__dict__  # small: kept
+    monkeypatch.setattr(stiffness, "RELEASE_ASSEMBLER_ABOVE", 0)
+    U1, R1 = stiffness.linear_response(model, F, fixed)
+    assert "assembler" not in model.__dict__
+    np.testing.assert_array_equal(U1, U0)
+    np.testing.assert_array_equal(R1, R0)
+    assert abs(tangent_stiffness(model) - K0).max() == 0.0
+    assert model.release_assembler() > 0 and model.release_assembler() == 0
+
+
+def test_linear_buckling_that_drops_the_assembler_finds_the_same_factor(monkeypatch):
+    """The buckling factor of a shallow arch is the same whether the assembler is kept or
+    freed before each factorisation (and rebuilt for the geometric stiffness, with the factor
+    released meanwhile as for a large model)."""
+    import barhinge.analysis.buckling as buckling
+    import barhinge.analysis.stiffness as stiffness
+    from barhinge.analysis.buckling import linear_buckling
+
+    L, b = 10.0, 1.0
+    mat = bh.Material(E=1e6, nu=NU, t=0.01)
+    cp = grid_sheet(8, 1, lambda u, v: np.column_stack([u * L, v * b, 1.0 * np.sin(np.pi * u)]))
+    model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=mat)
+    fixed, _ = _simply_supported(model, L, diaphragm=True)
+    fixed[np.abs(model.X0[:, 0] - L) < 1e-9, 0] = True  # pinned ends: the arch thrusts
+    F = self_weight(model, 1.0, g=(0.0, 0.0, -1.0))
+    kept = linear_buckling(model, F, fixed, n_modes=2).factors
+    monkeypatch.setattr(stiffness, "RELEASE_ASSEMBLER_ABOVE", 0)
+    monkeypatch.setattr(buckling, "RELEASE_FACTOR_ABOVE", 0)
+    freed = linear_buckling(model, F, fixed, n_modes=2).factors
+    assert "assembler" not in model.__dict__
+    np.testing.assert_allclose(freed, kept, rtol=1e-9)
