@@ -34,7 +34,13 @@ from barhinge.kernels.geometry import (
     hinge_angle_gradient,
     hinge_energy_hessian_packed,
 )
-from barhinge.linalg.backends import SingularMatrixError, get_backend, refined_solve
+from barhinge.linalg.backends import (
+    SingularMatrixError,
+    factorize_symmetric,
+    get_backend,
+    refined_solve,
+)
+from barhinge.linalg.symmetric import UpperSymmetric
 from barhinge.linalg.threads import threads_for_sparse
 
 __all__ = [
@@ -169,11 +175,13 @@ def linear_buckling(
     free = np.flatnonzero(~F.ravel())
     if len(free) < 2:
         raise ConfigError("linear buckling needs at least two free DOFs")
-    Kff = sp.csr_matrix(model.tangent(X)[free][:, free])  # the full tangent is not kept
+    # the supported stiffness as its upper triangle (the array PARDISO reads); the full
+    # tangent is not kept
+    Kff = UpperSymmetric.from_full(model.tangent(X)[free][:, free])
     make_room_for_factor(model)
     backend = get_backend("auto")
     try:
-        lu = backend.factorize(Kff)  # symmetric: PARDISO, else SuperLU
+        lu = factorize_symmetric(backend, Kff)  # PARDISO, else SuperLU
     except SingularMatrixError as exc:
         raise BucklingError(
             "linear buckling: the supported stiffness is singular (a mechanism); add supports"
@@ -206,15 +214,15 @@ def linear_buckling(
     if release:  # the geometric stiffness is assembled without the factor beside it
         del lu
         backend.release()  # type: ignore[attr-defined]
-    A = geometric_stiffness(model, X, dS, dM)[free][:, free]
-    A.data *= -1.0
+    A = UpperSymmetric.from_full(geometric_stiffness(model, X, dS, dM)[free][:, free])
+    A = A.scaled(-1.0)
     if release:  # numeric only: the ordering is kept
         make_room_for_factor(model)
-        lu = backend.factorize(Kff)
+        lu = factorize_symmetric(backend, Kff)
     k = min(int(n_modes), len(free) - 1)
     Kinv = spla.LinearOperator(Kff.shape, matvec=lu.solve, dtype=float)
     try:
-        mu, vec = spla.eigsh(A, k=k, M=Kff, Minv=Kinv, which="LA", tol=1e-10)
+        mu, vec = spla.eigsh(A.operator(), k=k, M=Kff.operator(), Minv=Kinv, which="LA", tol=1e-10)
     except (spla.ArpackNoConvergence, spla.ArpackError, RuntimeError, ValueError) as exc:
         raise BucklingError(f"linear buckling: the eigensolver failed ({exc})") from exc
     pos = mu > 1e-12 * max(float(np.abs(mu).max()), 1e-300)

@@ -25,8 +25,14 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from barhinge.errors import ConfigError
-from barhinge.linalg.backends import SingularMatrixError, get_backend, refined_solve
+from barhinge.linalg.backends import (
+    SingularMatrixError,
+    factorize_symmetric,
+    get_backend,
+    refined_solve,
+)
 from barhinge.linalg.heap import release_free_heap
+from barhinge.linalg.symmetric import UpperSymmetric
 from barhinge.linalg.threads import sparse_solves
 
 __all__ = [
@@ -138,9 +144,11 @@ def linear_response(
         raise ConfigError(f"loads must have shape ({n}, 3), got {f.shape}")
     free = free_dofs(fixed, n)
     K = tangent_stiffness(model, X) if K is None else sp.csr_matrix(K)
-    Kff = K[free][:, free].tocsr()
     held = np.setdiff1d(np.arange(3 * n), free)
     K_held = K[held]  # the reactions' rows: the rest of K is not kept beside the factor
+    # the supported stiffness as its upper triangle: the array PARDISO reads, and all the
+    # refinement's residuals need (the full matrix beside it: 1.9 GB at 2.4 M DOFs)
+    Kff = UpperSymmetric.from_full(K[free][:, free])
     del K
     make_room_for_factor(model)
     try:
@@ -148,7 +156,7 @@ def linear_response(
         # symmetric mode): a general LU of this symmetric matrix fills in several times more
         ff = f.ravel()[free]
         with sparse_solves():
-            lu = get_backend("auto").factorize(Kff)
+            lu = factorize_symmetric(get_backend("auto"), Kff)
             uf, rel = refined_solve(lu, Kff, ff)  # rel: |ff - Kff uf| / |ff|, extended
     except SingularMatrixError as exc:  # exactly singular
         raise ConfigError(

@@ -38,6 +38,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from barhinge.errors import ConfigError
+from barhinge.linalg.symmetric import UpperSymmetric
 
 __all__ = [
     "EXTENDED",
@@ -49,6 +50,7 @@ __all__ = [
     "SuperLUBackend",
     "available_backends",
     "extended_residual",
+    "factorize_symmetric",
     "get_backend",
     "refined_solve",
 ]
@@ -493,31 +495,38 @@ EXTENDED: type[np.floating] | None = (
 _RESIDUAL_CHUNK_NNZ = 4_000_000
 
 
-def extended_residual(A: sp.spmatrix, x: np.ndarray, b: np.ndarray) -> np.ndarray:
+def extended_residual(A: sp.spmatrix | UpperSymmetric, x: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``b - A x`` accumulated in extended precision (:data:`EXTENDED`), in chunks of rows
     so that only about 4 M nonzeros are held in the wider type at a time. In double
     precision the rounding of the products alone leaves a residual of about
     ``eps |A| |x|``, which on stiff, finely meshed plates exceeds the residual of the
-    solution itself; the 64-bit mantissa moves that floor down by a factor of 2048."""
+    solution itself; the 64-bit mantissa moves that floor down by a factor of 2048. A
+    symmetric ``A`` held as its upper triangle (:class:`UpperSymmetric`) adds each chunk's
+    rows and their mirrors."""
     dtype = EXTENDED or np.float64
-    A = sp.csr_matrix(A)
+    symmetric = isinstance(A, UpperSymmetric)
+    M = A.upper if isinstance(A, UpperSymmetric) else sp.csr_matrix(A)
     xe = np.asarray(x, dtype=dtype)
     r = np.asarray(b, dtype=dtype).copy()
-    indptr = A.indptr
+    indptr = M.indptr
+    n_rows = M.shape[0]
     cuts = np.searchsorted(indptr, np.arange(0, indptr[-1], _RESIDUAL_CHUNK_NNZ), side="right")
-    bounds = np.unique(np.concatenate([[0], cuts - 1, [A.shape[0]]]).clip(0, A.shape[0]))
+    bounds = np.unique(np.concatenate([[0], cuts - 1, [n_rows]]).clip(0, n_rows))
     for r0, r1 in zip(bounds[:-1], bounds[1:], strict=True):
         lo, hi = indptr[r0], indptr[r1]
         block = sp.csr_matrix(
-            (A.data[lo:hi].astype(dtype), A.indices[lo:hi], indptr[r0 : r1 + 1] - lo),
-            shape=(int(r1 - r0), A.shape[1]),
+            (M.data[lo:hi].astype(dtype), M.indices[lo:hi], indptr[r0 : r1 + 1] - lo),
+            shape=(int(r1 - r0), M.shape[1]),
         )
         r[r0:r1] -= block @ xe
+        if symmetric:  # the mirrored entries, less the diagonal counted twice
+            r -= block.T @ xe[r0:r1]
+            r[r0:r1] += block.diagonal(k=int(r0)) * xe[r0:r1]
     return r
 
 
 def refined_solve(
-    factor: Factor, A: sp.spmatrix, b: np.ndarray, max_steps: int = 10
+    factor: Factor, A: sp.spmatrix | UpperSymmetric, b: np.ndarray, max_steps: int = 10
 ) -> tuple[np.ndarray, float]:
     """Solve ``A x = b`` with a factor of ``A`` and mixed-precision iterative refinement
     (Wilkinson; Higham 2002, Accuracy and Stability of Numerical Algorithms, ch. 12):
@@ -530,8 +539,10 @@ def refined_solve(
     factor that solves only approximately (perturbed pivots, a nearby matrix). Returns
     ``(x, |b - A x| / |b|)``: the residual of the refined solution before it is rounded to
     double (the rounding moves each entry by at most half a unit in its last place). Without
-    an extended type (:data:`EXTENDED` None) the same steps run in double precision."""
-    A = sp.csr_matrix(A)
+    an extended type (:data:`EXTENDED` None) the same steps run in double precision.
+    ``A`` may be held as its upper triangle (:class:`UpperSymmetric`)."""
+    if not isinstance(A, UpperSymmetric):
+        A = sp.csr_matrix(A)
     dtype = EXTENDED or np.float64
     x = np.asarray(factor.solve(b), dtype=dtype)
     bn = max(float(np.linalg.norm(b)), 1e-300)
@@ -550,6 +561,39 @@ def refined_solve(
         if not fast:
             break
     return np.asarray(x, dtype=np.float64), rel
+
+
+#: a symmetric factor whose smallest pivot is below this fraction of its largest is
+#: numerically singular (:func:`factorize_symmetric`): a strut of rigid links left free to
+#: turn as a mechanism factorises with 6e-17, the supported strut with 4e-8 (1 / its
+#: condition number, roughly; double precision solves nothing beyond 1 / eps = 4.5e15)
+SINGULAR_PIVOT_RATIO = 1e-15
+
+
+def factorize_symmetric(backend: LinearBackend, A: UpperSymmetric) -> Factor:
+    """Factorise the symmetric matrix held as its upper triangle. PARDISO reads the upper
+    triangle itself (no copy is made; the factor keeps a reference to it); a factorisation
+    that needed perturbed pivots (nearly singular to working precision), a triangle that
+    does not store every diagonal entry, and the other backends are given the full matrix.
+    A SuperLU factor whose pivots span more than :data:`SINGULAR_PIVOT_RATIO` raises
+    SingularMatrixError: its solve would only be a rounding of a mechanism's motion."""
+    if isinstance(backend, PardisoBackend) and not backend.definite and A.stores_diagonal():
+        factor = backend.factorize(A.upper, upper=True)
+        if factor.perturbed_pivots() == 0:  # type: ignore[attr-defined]
+            return factor
+        log.debug("PARDISO perturbed pivots; SuperLU for this matrix")
+        del factor
+        backend.release()
+        factor = SuperLUBackend().factorize(A.full())
+    else:
+        factor = backend.factorize(A.full())
+    if isinstance(factor, _SuperLUFactor):
+        pivots = np.abs(factor._lu.U.diagonal())
+        if pivots.size and not pivots.min() > SINGULAR_PIVOT_RATIO * pivots.max():
+            raise SingularMatrixError(
+                f"numerically singular: pivots from {pivots.min():.1e} to {pivots.max():.1e}"
+            )
+    return factor
 
 
 def available_backends() -> list[str]:

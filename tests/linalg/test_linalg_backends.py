@@ -292,22 +292,10 @@ def test_pardiso_cholesky_solves_normal_equations_like_a_dense_solve():
         backend.factorize(Ks)
 
 
-def _beam_fourth_difference(n: int) -> tuple[sp.csr_matrix, np.ndarray]:
-    """``A = D^2`` (D the second difference with zero ends: a simply supported beam, ghost
-    nodes mirrored) and the exact solution of ``A w = 1``: the quartic
-    ``w_i = (i^4 - 2 N i^3 - i^2 + (N^3 + N) i) / 24``, ``N = n + 1`` (second differences
-    of polynomials are exact: ``D`` of the parabola ``-i (N - i) / 2`` is 1, ``D`` of w is
-    that parabola, and w vanishes at i = 0 and N). Integers below 2^53: exact in double."""
-    D = sp.diags([np.ones(n - 1), -2.0 * np.ones(n), np.ones(n - 1)], [-1, 0, 1], format="csr")
-    i = np.arange(1, n + 1, dtype=float)
-    N = n + 1.0
-    return sp.csr_matrix(D @ D), (i**4 - 2 * N * i**3 - i**2 + (N**3 + N) * i) / 24.0
-
-
 @pytest.mark.skipif(EXTENDED is None, reason="numpy's longdouble is a double here")
 @pytest.mark.parametrize("backend", ["superlu", "auto"])
 def test_refined_solve_in_extended_precision_solves_a_system_whose_double_residual_floors(
-    backend, monkeypatch
+    backend, monkeypatch, beam_fourth_difference
 ):
     """The 3000-node fourth difference (cond ~ 1.7e13, like a finely meshed plate): any
     double vector's residual is held near ``eps |A| |x| / |b|`` ~ 4e-4 by the rounding of
@@ -316,7 +304,7 @@ def test_refined_solve_in_extended_precision_solves_a_system_whose_double_residu
     ch. 12: mixed-precision refinement, forward error ~ cond * eps_extended)."""
     from barhinge.linalg.backends import extended_residual, get_backend, refined_solve
 
-    A, w = _beam_fourth_difference(3000)
+    A, w = beam_fourth_difference(3000)
     b = np.ones(len(w))
     assert np.all(extended_residual(A, w, b) == 0.0)  # the closed form solves it exactly
     factor = get_backend(backend).factorize(A)
