@@ -339,6 +339,8 @@ def summary(
         "refined": refined,
         "m": rows[-1]["m"],
         "n_dof": rows[-1]["n_dof"],
+        # the DOFs of the level after the last (the one the budget refused, if not refined)
+        "next_dof": roofs.refinement_dofs(cp, 2 * rows[-1]["m"]),
         "change": dk,
         "stiffness": k[-1],
         "stiffness_per_width": k[-1] / width,
@@ -689,7 +691,13 @@ def findings(results: list[dict], coarse: dict[str, dict[str, str]]) -> str:
             " correction as the uncertainty; the panels' corners, where a folded sheet's"
             " stresses are singular, set their slow convergence (*Against a shell model*,"
             " finding 6). The budget is set by the memory of the machine the study runs on"
-            " (23.5 GB); the finest levels are solved with their residuals accumulated in"
+            " (23.5 GB)"
+            + (
+                f": their next level has {min(r['next_dof'] for r in open_):,} DOFs or more"
+                if open_
+                else ""
+            )
+            + "; the finest levels are solved with their residuals accumulated in"
             " extended precision (a plate's stiffness matrix is conditioned like the cell"
             " size to the power -4: in double precision the rounding of the residual alone"
             " exceeds the 1e-4 that `linear_response` accepts at the parallelogram roofs'"
