@@ -26,6 +26,7 @@ Meshes are small (a few hundred elements) so the tests stay fast. Whole-panel co
 
 from __future__ import annotations
 
+import warnings
 from typing import Any
 
 import numpy as np
@@ -320,7 +321,17 @@ def _condensed(K: sp.spmatrix, keep: np.ndarray, drop: np.ndarray) -> np.ndarray
     if len(drop) == 0:
         return Kkk
     Kkd = K[keep][:, drop]
-    X = spla.spsolve(sp.csc_matrix(K[drop][:, drop]), Kkd.T.toarray())
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", spla.MatrixRankWarning)
+        try:
+            X = spla.spsolve(sp.csc_matrix(K[drop][:, drop]), Kkd.T.toarray())
+        except spla.MatrixRankWarning:
+            X = np.full((len(drop), len(keep)), np.nan)
+    if not np.all(np.isfinite(X)):
+        raise ConfigError(
+            "the continuum plate of a panel is singular with its corners held: a sliver "
+            "panel (corners nearly on a line) or a material without stiffness"
+        )
     return Kkk - Kkd @ np.asarray(X).reshape(len(drop), len(keep))
 
 

@@ -137,3 +137,14 @@ def test_plate_reference_at_the_default_refinement(P, tol: float) -> None:
     rate = np.log2(d[0] / d[1])
     limit = tr[2] + d[1] / (2.0**rate - 1.0)
     assert abs(tr[1] / limit - 1.0) < tol
+
+
+def test_a_sliver_panel_is_a_named_error_not_a_stiffness_of_nan() -> None:
+    """A quadrilateral 1e-12 high: its plate with the corners held is singular (the solve
+    with scipy warned and returned NaN). It is refused with a message naming the cause."""
+    from barhinge.errors import ConfigError
+
+    mat = Material(E=1e6, nu=0.3, t=0.01)
+    sliver = np.array([[0, 0], [1, 0], [1, 1e-12], [0, 1e-12]], float)
+    with pytest.raises(ConfigError, match="sliver"):
+        cont.plate_corner_stiffness(sliver, mat)
