@@ -575,8 +575,9 @@ def factorize_symmetric(backend: LinearBackend, A: UpperSymmetric) -> Factor:
     triangle itself (no copy is made; the factor keeps a reference to it); a factorisation
     that needed perturbed pivots (nearly singular to working precision), a triangle that
     does not store every diagonal entry, and the other backends are given the full matrix.
-    A SuperLU factor whose pivots span more than :data:`SINGULAR_PIVOT_RATIO` raises
-    SingularMatrixError: its solve would only be a rounding of a mechanism's motion."""
+    A SuperLU factor whose smallest pivot is below :data:`SINGULAR_PIVOT_RATIO` times its
+    largest raises SingularMatrixError: its solve would only be a rounding of a mechanism's
+    motion."""
     if isinstance(backend, PardisoBackend) and not backend.definite and A.stores_diagonal():
         factor = backend.factorize(A.upper, upper=True)
         if factor.perturbed_pivots() == 0:  # type: ignore[attr-defined]
