@@ -38,7 +38,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from barhinge.errors import ConfigError
-from barhinge.linalg.symmetric import UpperSymmetric
+from barhinge.linalg.symmetric import UpperSymmetric, upper_triangle_map
 
 __all__ = [
     "EXTENDED",
@@ -385,11 +385,7 @@ class PardisoBackend:
         sample = A.indices[:: max(1, A.nnz // 997)]
         key = (n, A.nnz, hash(A.indptr.tobytes()), hash(sample.tobytes()))
         if key != self._upper_key:
-            rows = np.repeat(np.arange(n), np.diff(A.indptr))
-            keep = A.indices >= rows
-            pos = np.flatnonzero(keep)
-            indptr = np.concatenate([[0], np.cumsum(np.bincount(rows[keep], minlength=n))])
-            indices = A.indices[keep]
+            pos, indices, indptr = upper_triangle_map(A)
             if np.any(np.diff(indptr) == 0) or np.any(indices[indptr[:-1]] != np.arange(n)):
                 raise SingularMatrixError("matrix does not store every diagonal entry")
             self._upper_map = (pos, indices.astype(np.int32), indptr.astype(np.int32))

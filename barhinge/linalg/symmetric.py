@@ -13,7 +13,20 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-__all__ = ["UpperSymmetric"]
+__all__ = ["UpperSymmetric", "upper_triangle_map"]
+
+
+def upper_triangle_map(A: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where the upper triangle of the CSR matrix ``A`` (sorted indices) lies in its values:
+    ``(positions, indices, indptr)``, so that ``csr_matrix((A.data[positions], indices,
+    indptr))`` is the triangle (explicit zeros kept). Index arrays in ``A``'s index type."""
+    n = A.shape[0]
+    rows = np.repeat(np.arange(n, dtype=A.indices.dtype), np.diff(A.indptr))
+    keep = A.indices >= rows
+    counts = np.bincount(rows[keep], minlength=n)
+    del rows
+    indptr = np.concatenate([[0], np.cumsum(counts)]).astype(A.indptr.dtype)
+    return np.flatnonzero(keep), A.indices[keep], indptr
 
 
 class UpperSymmetric:
@@ -39,13 +52,8 @@ class UpperSymmetric:
         A = sp.csr_matrix(A)
         if not A.has_sorted_indices:
             A.sort_indices()
-        n = A.shape[0]
-        rows = np.repeat(np.arange(n, dtype=A.indices.dtype), np.diff(A.indptr))
-        keep = A.indices >= rows
-        counts = np.bincount(rows[keep], minlength=n)
-        del rows
-        indptr = np.concatenate([[0], np.cumsum(counts)]).astype(A.indptr.dtype)
-        U = sp.csr_matrix((A.data[keep], A.indices[keep], indptr), shape=A.shape)
+        pos, indices, indptr = upper_triangle_map(A)
+        U = sp.csr_matrix((A.data[pos], indices, indptr), shape=A.shape)
         U.has_sorted_indices = True
         return cls(U)
 
