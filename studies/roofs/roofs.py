@@ -393,7 +393,7 @@ REFINE_DOF_BUDGET = 650_000
 #: the refinement study's budget (refine.py): m = 128 on the roofs of triangular panels
 #: (Yoshimura, Resch, waterbomb: about 1.3 M DOFs) and m = 64 on the parallelogram roofs
 #: (miura75, miura_arc: 1.77 M DOFs; miura60: 2.36 M DOFs, a level's process peaking at
-#: 18.3 GB: linear analyses hold the stiffness as its upper triangle and drop the assembler
+#: 17.4 GB: linear analyses hold the stiffness as its upper triangle and drop the assembler
 #: before they factorise, ``linear_response``). The
 #: next levels (m = 256: over 5 M DOFs) do not fit a machine of 23.5 GB. Solves this fine
 #: need the residuals in extended precision (``refined_solve``).
