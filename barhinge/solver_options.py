@@ -91,6 +91,18 @@ class SolverOptions:
         sheet pays nothing. ``True``: every correction; ``False``: none.
         docs/solver-performance.md, the acceleration table, measures all three. Not used
         under arc length.
+    corrector : str
+        ``"chord"`` (default): after an increment's first Newton correction (which always
+        assembles and factorises the tangent at the predicted state), each further
+        correction is first tried as a chord step: the residual is evaluated without the
+        tangent and solved with the increment's factorisation (one back-substitution). The
+        step is kept when it lowers the force residual at least ``1 / CHORD_CONTRACTION``
+        times (or passes the force test); otherwise it is discarded and a full Newton
+        correction (tangent assembled and factorised) is made from the same iterate. Where
+        the first correction lowered the residual by orders of magnitude, the chord's
+        contraction is of the same order, so most increments need one factorisation
+        (docs/solver-performance.md, the corrector table). ``"newton"``: every correction
+        assembles and factorises the tangent. Not used under arc length.
     reuse_factorization : bool
         Reuse a factorisation over Newton iterations and increments as the preconditioner
         of GMRES on the exact tangent system (a fresh factorisation when GMRES stalls or has
@@ -162,6 +174,7 @@ class SolverOptions:
     predictor: str = "polynomial"
     line_search: int = 0
     acceleration: bool | str = "auto"
+    corrector: str = "chord"
     reuse_factorization: bool = False
     krylov_max: int = 30
     arc_length_increment: float | None = None
@@ -201,6 +214,7 @@ class SolverOptions:
             self.predictor, "options.predictor", ("polynomial", "quadratic", "secant", "tangent")
         )
         _check.choice(self.flat_start, "options.flat_start", ("rigid", "tangent"))
+        _check.choice(self.corrector, "options.corrector", ("chord", "newton"))
         _check.boolean(self.reuse_factorization, "options.reuse_factorization")
         if self.acceleration != "auto":
             _check.boolean(self.acceleration, "options.acceleration")

@@ -45,6 +45,7 @@ COLS = (
     "material",
     "DOF",
     "iterations",
+    "chord corr.",
     "failed incr.",
     "factorisations",
     "fact./step",
@@ -68,6 +69,7 @@ def run(n: int, material: str, steps: int, options: dict) -> dict:
     return {
         "dof": sc.model.n_dof,
         "iterations": nw["total_iterations"],
+        "chord": nw["total_chord"],
         "failed": nw["total_failed"],
         "fact": path.meta["timing"]["n_factorizations"],
         "fact1": nw["factorizations"][0],
@@ -116,6 +118,7 @@ def main() -> None:
                 material,
                 r["dof"],
                 r["iterations"],
+                r["chord"],
                 r["failed"],
                 r["fact"],
                 f"{r['fact'] / a.steps:.1f}",
@@ -149,6 +152,12 @@ def main() -> None:
         "Predictor (option `predictor`): the quadratic and the polynomial of the degree the "
         "path supports",
         ("quadratic", "polynomial"),
+    )  # fmt: skip
+    compare(
+        out, runs_of, a, options, "corrector", ("newton", "chord"),
+        "Corrector (option `corrector`): a factorisation per Newton correction, and chord "
+        "corrections with the increment's factorisation while they contract (the default)",
+        ("newton", "chord"),
     )  # fmt: skip
     if a.publish:
         publish(lines, a)

@@ -170,6 +170,8 @@ def summary_rows(summary: dict[str, Any], path: FoldPath | None = None) -> list[
                     f"{nw.get('total_failed', 0)})",
                 )
             )
+        if nw.get("total_chord"):
+            rows.append(("chord corrections", str(nw["total_chord"])))
     if summary["wall_time_s"] is not None:
         rows.append(("wall time (s)", f"{summary['wall_time_s']:.2f}"))
     if summary.get("linear_solver"):

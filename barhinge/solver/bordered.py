@@ -65,6 +65,8 @@ class Timer:
     n_krylov: int = 0
     n_force_only: int = 0  # evaluations without the tangent (convergence expected)
     n_accelerated: int = 0  # Newton corrections taken with their geodesic acceleration
+    n_chord: int = 0  # chord corrections kept (solved with the increment's factorisation)
+    n_chord_rejected: int = 0  # chord corrections tried and discarded for a Newton one
 
     def as_dict(self) -> dict[str, float]:
         return dataclasses.asdict(self)

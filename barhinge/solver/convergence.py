@@ -73,6 +73,13 @@ class Convergence:
             return bool(ok_f and ok_x and ok_c)
         return float(np.linalg.norm(next_correction())) <= tol_x
 
+    def passes(self, e: Evaluation, st: State) -> bool:
+        """Whether ``st`` passes the force and actuator tests (not the displacement one)."""
+        ctx, o = self.ctx, self.ctx.opts
+        rf = float(np.linalg.norm(e.r[ctx.free]))
+        ok_f = rf <= o.tol_force * self.force_ref(e, st) + ctx.floor
+        return bool(ok_f and ((not ctx.n_act) or float(np.max(np.abs(e.c))) <= o.tol_angle))
+
     def merit(self, e: Evaluation) -> float:
         """``|r_free|^2 + (s c)^2``, force^2."""
         free, s = self.ctx.free, self.ctx.c_scale

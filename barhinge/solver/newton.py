@@ -43,6 +43,11 @@ ACCELERATION_RATIO = 0.5
 #: option acceleration "auto": an increment that needed more Newton corrections than this
 #: (or failed) has the next one accelerated from its first correction
 AUTO_ACCELERATION_AFTER = 2
+#: option corrector "chord": a chord correction is kept when it lowers the root of the merit
+#: ``|r_free|^2 + (s c)^2`` at least 1 / CHORD_CONTRACTION times (or the state passes the
+#: force and actuator tests); a chord contracting less would cost more back-substitutions
+#: and force evaluations than the Newton correction (one assembly and factorisation) it saves
+CHORD_CONTRACTION = 0.1
 
 if TYPE_CHECKING:
     from barhinge.scene import Scene
@@ -125,7 +130,8 @@ class _Driver:
         x_pred = new.x.copy()
         e = self._pred_eval if self._pred_eval is not None else ctx.evaluate(new)
         dx_last: np.ndarray | None = None
-        n_iter = 0
+        n_iter = 0  # Newton corrections (each factorises)
+        n_chord = 0  # chord corrections kept (solved with the increment's factorisation)
         while True:
             rf = float(np.linalg.norm(e.r[free]))
             res.append(rf)
@@ -133,8 +139,13 @@ class _Driver:
             if not np.isfinite(rf) or not np.all(np.isfinite(e.c)):
                 raise IncrementFailed("non-finite residual", res)
 
-            def next_correction(e: Evaluation = e) -> np.ndarray:
-                return self.system.solve(-e.r[free], -e.c)[0]
+            chord_step: list[tuple[np.ndarray, np.ndarray]] = []
+
+            def next_correction(
+                e: Evaluation = e, out: list[tuple[np.ndarray, np.ndarray]] = chord_step
+            ) -> np.ndarray:
+                out.append(self.system.solve(-e.r[free], -e.c))
+                return out[-1][0]
 
             if dx_last is not None and self.conv.converged(e, new, dx_last, next_correction):
                 self.n_iter_last = n_iter
@@ -142,10 +153,16 @@ class _Driver:
                 self.inertia.check_inertia(res)
                 self.inertia.check_jump(st, x_pred, new, res)
                 return new, e, res
-            if n_iter >= o.max_iter:
+            if n_iter + n_chord >= o.max_iter:
                 raise IncrementFailed(f"no convergence in {o.max_iter} iterations", res)
             if len(res) > 2 and rf > o.divergence_ratio * max(res[0], ctx.floor):
                 raise IncrementFailed("residual diverged", res)
+            if n_iter and self._chord_allowed(res):
+                chord = self._chord(new, e, chord_step[0] if chord_step else None)
+                if chord is not None:
+                    new, e, dx_last = chord
+                    n_chord += 1
+                    continue
             if e.ev.K is None:  # evaluated without tangent (convergence was expected)
                 e = ctx.evaluate(new)
             # the first correction always factorises: the predictor's bar forces change the
@@ -159,6 +176,40 @@ class _Driver:
             light = self._expects_convergence(res)
             new, e, alpha = self.conv.line_search(new, e, dx, dmu, light)
             dx_last = alpha * dx
+
+    def _chord_allowed(self, res: list[float]) -> bool:
+        """Whether the next correction is first tried as a chord step (option
+        ``corrector``): not where Newton's corrections are being accelerated (the
+        near-mechanism, where the tangent changes fast), and only with a factorisation of
+        the current increment's tangent at hand."""
+        return (
+            self.opts.corrector == "chord"
+            and self.system.current_factored
+            and not self._accelerate(res)
+        )
+
+    def _chord(
+        self,
+        st: State,
+        e: Evaluation,
+        step: tuple[np.ndarray, np.ndarray] | None,
+    ) -> tuple[State, Evaluation, np.ndarray] | None:
+        """The chord correction from ``st`` (the residual solved with the increment's
+        factorisation; ``step``: that solve, if the convergence test made it), its
+        evaluation without the tangent, and the correction; None (the trial discarded)
+        when it does not contract the merit by ``CHORD_CONTRACTION`` and the state does not
+        pass the force and actuator tests."""
+        ctx, conv = self.ctx, self.conv
+        dx, dmu = step if step is not None else self.system.solve(-e.r[self.free], -e.c)
+        trial = State(st.x.copy(), st.mu + dmu, st.lam, st.t)
+        trial.x[self.free] += dx
+        et = ctx.evaluate(trial, tangent=False)
+        m0, m1 = conv.merit(e), conv.merit(et)
+        if np.isfinite(m1) and (m1 <= CHORD_CONTRACTION**2 * m0 or conv.passes(et, trial)):
+            ctx.timer.n_chord += 1
+            return trial, et, dx
+        ctx.timer.n_chord_rejected += 1
+        return None
 
     def _accelerated(
         self, st: State, e: Evaluation, dx: np.ndarray, dmu: np.ndarray, rtol: float
@@ -353,6 +404,7 @@ class _Driver:
             iters, res_all = 0, []
             n_inc = n_failed = 0
             fact0 = timer.n_factorizations
+            chord0 = timer.n_chord
             critical = ""  # a limit-point diagnosis from any attempt since the last success
             while st.t < t_goal - 1e-12 * h0:
                 h_try = min(h, t_goal - st.t)
@@ -398,6 +450,7 @@ class _Driver:
                     failed=n_failed,
                     factorizations=timer.n_factorizations - fact0,
                     inertia_factorizations=timer.n_factorizations - fact1,
+                    chord=timer.n_chord - chord0,
                 )
             )
             self.record(st, e_new, iters, res_all, counts)

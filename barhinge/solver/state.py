@@ -83,3 +83,4 @@ class StepStats:
     failed: int  # failed increments (redone shorter)
     factorizations: int  # all factorisations
     inertia_factorizations: int  # those made to confirm the inertia at the state
+    chord: int = 0  # chord corrections kept (options.corrector = "chord")

@@ -18,7 +18,10 @@ from bench_solver import miura_scene  # noqa: E402
 
 def _solve(n: int, material: str, acceleration: bool | str, steps: int = 50):
     sc = miura_scene(n, 0.0, steps, material=material)
-    return bh.solve(sc.with_(options={**sc.options.__dict__, "acceleration": acceleration}))
+    # Newton corrections alone: the acceleration acts on them (chord corrections are
+    # tested in test_solve_chord)
+    opts = {**sc.options.__dict__, "acceleration": acceleration, "corrector": "newton"}
+    return bh.solve(sc.with_(options=opts))
 
 
 @pytest.fixture(scope="module")

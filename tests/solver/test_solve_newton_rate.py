@@ -17,7 +17,14 @@ from barhinge.families import miura_line_creases
 from barhinge.model.model import BarHingeModel
 from barhinge.scene import Scene, select_vertices
 
-OPTS = {"predictor": "tangent", "tol_force": 1e-13, "tol_disp": 1e-14, "force_floor": 1e-11}
+# Newton corrections only (no chord corrections, whose rate is linear by design)
+OPTS = {
+    "predictor": "tangent",
+    "corrector": "newton",
+    "tol_force": 1e-13,
+    "tol_disp": 1e-14,
+    "force_floor": 1e-11,
+}
 
 
 def _rate(res: tuple[float, ...]) -> float:
