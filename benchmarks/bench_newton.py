@@ -85,8 +85,15 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--sizes", type=int, nargs="*", default=[10, 20])
     ap.add_argument("--steps", type=int, default=50)
-    ap.add_argument("--repeat", type=int, default=1)
+    ap.add_argument("--repeat", type=int, default=3, help="runs per row (wall and CPU: medians)")
     ap.add_argument("--options", default="{}", help="solver options (JSON) for every run")
+    ap.add_argument(
+        "--corrector-sizes",
+        type=int,
+        nargs="*",
+        default=[],
+        help="larger quasi-rigid sheets on which only the two correctors are compared",
+    )
     ap.add_argument("--publish", action="store_true", help="write into docs/")
     a = ap.parse_args()
     lines: list[str] = []
@@ -159,13 +166,19 @@ def main() -> None:
         "corrections with the increment's factorisation while they contract (the default)",
         ("newton", "chord"),
     )  # fmt: skip
+    if a.corrector_sizes:
+        larger = {(n, "quasi-rigid"): None for n in a.corrector_sizes}
+        compare(
+            out, larger, a, options, "corrector", ("newton", "chord"),
+            "Corrector on larger quasi-rigid sheets", ("newton", "chord"),
+        )  # fmt: skip
     if a.publish:
         publish(lines, a)
 
 
 def compare(
     out: Callable[..., None],
-    runs_of: dict[tuple[int, str], dict],
+    runs_of: dict[tuple[int, str], dict | None],
     a: argparse.Namespace,
     options: dict,
     key: str,
@@ -176,7 +189,8 @@ def compare(
     """A table of every size and set run with each of ``values`` of option ``key``:
     iterations, Newton factorisations (the inertia ones left out), failed increments, wall
     time, and the ratios of Newton factorisations and wall time of each later value to the
-    first. The runs of the main table are reused for the value it ran with."""
+    first. The runs of the main table are reused for the value it ran with (None: every
+    value is run)."""
     ran_with = options.get(key, getattr(SolverOptions(), key))
     names = " / ".join(labels)
     ratio_cols = [f"{lab} / {labels[0]}" for lab in labels[1:]]
@@ -192,7 +206,7 @@ def compare(
     for (n, material), r in runs_of.items():
         row = []
         for v in values:
-            if v == ran_with and type(v) is type(ran_with):
+            if r is not None and v == ran_with and type(v) is type(ran_with):
                 row.append(r)
                 continue
             other = [run(n, material, a.steps, {**options, key: v}) for _ in range(a.repeat)]
@@ -217,6 +231,8 @@ def publish(lines: list[str], a: argparse.Namespace) -> None:
     text = doc.read_text()
     start, end = "<!-- bench_newton:start -->", "<!-- bench_newton:end -->"
     cmd = "python benchmarks/bench_newton.py --publish"
+    if a.corrector_sizes:
+        cmd += " --corrector-sizes " + " ".join(str(n) for n in a.corrector_sizes)
     if a.options != "{}":
         cmd += f" --options '{a.options}'"
     body = "\n".join([start, f"Written by `{cmd}` (this machine).", "", *lines, end])
