@@ -96,11 +96,11 @@ class SolverOptions:
         assembles and factorises the tangent at the predicted state), each further
         correction is first tried as a chord step: the residual is evaluated without the
         tangent and solved with the increment's factorisation (one back-substitution). The
-        step is kept when it lowers the force residual at least ``1 / CHORD_CONTRACTION``
-        times (or passes the force test); otherwise it is discarded and a full Newton
-        correction (tangent assembled and factorised) is made from the same iterate. Where
-        the first correction lowered the residual by orders of magnitude, the chord's
-        contraction is of the same order, so most increments need one factorisation
+        step is kept when it lowers ``sqrt(|r_free|^2 + (s c)^2)`` at least
+        ``1 / CHORD_CONTRACTION`` times (ten) or its state passes the force and actuator
+        tests; otherwise it is discarded and a full Newton
+        correction (tangent assembled and factorised) is made from the same iterate. On a
+        smooth path most increments then need one factorisation
         (docs/solver-performance.md, the corrector table). ``"newton"``: every correction
         assembles and factorises the tangent. Not used under arc length.
     reuse_factorization : bool

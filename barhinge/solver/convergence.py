@@ -64,9 +64,9 @@ class Convergence:
         ctx = self.ctx
         o = ctx.opts
         rf = float(np.linalg.norm(e.r[ctx.free]))
-        self.tol_abs = o.tol_force * self.force_ref(e, st) + ctx.floor
+        self.tol_abs = self._force_tolerance(e, st)
         ok_f = rf <= self.tol_abs
-        ok_c = (not ctx.n_act) or float(np.max(np.abs(e.c))) <= o.tol_angle
+        ok_c = self._actuators_ok(e)
         tol_x = o.tol_disp * ctx.size
         ok_x = float(np.linalg.norm(dx)) <= tol_x
         if ok_x or not (ok_f and ok_c):
@@ -75,10 +75,17 @@ class Convergence:
 
     def passes(self, e: Evaluation, st: State) -> bool:
         """Whether ``st`` passes the force and actuator tests (not the displacement one)."""
-        ctx, o = self.ctx, self.ctx.opts
-        rf = float(np.linalg.norm(e.r[ctx.free]))
-        ok_f = rf <= o.tol_force * self.force_ref(e, st) + ctx.floor
-        return bool(ok_f and ((not ctx.n_act) or float(np.max(np.abs(e.c))) <= o.tol_angle))
+        rf = float(np.linalg.norm(e.r[self.ctx.free]))
+        return rf <= self._force_tolerance(e, st) and self._actuators_ok(e)
+
+    def _force_tolerance(self, e: Evaluation, st: State) -> float:
+        """``tol_force * F_ref + force_floor`` at ``st``, force."""
+        return self.ctx.opts.tol_force * self.force_ref(e, st) + self.ctx.floor
+
+    def _actuators_ok(self, e: Evaluation) -> bool:
+        """Whether every held actuator is within ``tol_angle`` of its target."""
+        ctx = self.ctx
+        return (not ctx.n_act) or float(np.max(np.abs(e.c))) <= ctx.opts.tol_angle
 
     def merit(self, e: Evaluation) -> float:
         """``|r_free|^2 + (s c)^2``, force^2."""
