@@ -31,6 +31,7 @@ from barhinge._protocols import SolverModel
 from barhinge.actuators import Actuators
 from barhinge.errors import BarhingeError, ConvergenceError
 from barhinge.kinematics.path import RigidOptions, actuator_conflict, rigid_fold
+from barhinge.linalg.extrapolation import lagrange
 from barhinge.model.triangulate import quad_centres, triangulate
 
 __all__ = [
@@ -46,6 +47,8 @@ log = logging.getLogger(__name__)
 
 #: a model whose fold hinges all lie within this of 0 rad starts flat
 FLAT_START_TOL = 1e-6
+#: requested steps of the rigid fold that :meth:`RigidGuide.at` interpolates through (cubic)
+STENCIL = 4
 
 
 def is_flat(model: SolverModel) -> bool:
@@ -149,12 +152,21 @@ class RigidGuide:
         return self.record["t_max"]
 
     def at(self, t: float) -> np.ndarray:
-        """(n_nodes, 3) rigid-fold coordinates at path parameter ``t`` in [0, t_max],
-        linear between the requested steps."""
-        s = t * self.record["steps"]
-        i = min(int(np.floor(s)), len(self.X) - 2)
-        f = s - i
-        return (1.0 - f) * self.X[i] + f * self.X[i + 1]
+        """(n_nodes, 3) rigid-fold coordinates at path parameter ``t`` in [0, t_max]: the
+        cubic through the four requested steps nearest ``t`` (exact at the steps).
+
+        Off a flat sheet the in-plane coordinates change like the square of the fold
+        angle, so a straight line between two steps shortens the panels: on a 40 x 40
+        Miura, halfway through the first step, by a bar strain of 8e-5 (against 1.5e-7
+        for the cubic), which the stiff bars turn into a large residual for the
+        increments that a failed first step is cut back to."""
+        steps = self.record["steps"]
+        s = t * steps
+        last = len(self.X) - 1
+        i = min(max(int(np.floor(s)), 0), last)
+        lo = max(0, min(i - 1, last - STENCIL + 1))
+        pts = [(k / steps, self.X[k]) for k in range(lo, min(lo + STENCIL, last + 1))]
+        return lagrange(pts, t)
 
 
 def rigid_guide(

@@ -249,3 +249,32 @@ def test_conflicting_actuators_of_a_folded_start_are_named_before_solving(caplog
     )
     first = next(i for i, r in enumerate(caplog.records) if "conflict" in r.getMessage())
     assert first == 0  # before anything the solve logs about its increments
+
+
+def test_rigid_guide_between_steps_is_the_cubic_through_the_rigid_fold():
+    """The rigid-fold predictor of increments shorter than a requested step (a cut-back first
+    step) lies on the rigid fold to fourth order in the step: against the rigid fold solved
+    at the off-step parameter itself (an independent rigid solve), halving the requested
+    step divides the error about 2**4 = 16 times (a straight line between steps, which
+    shortens the panels like the square of the fold angle, would divide it 4 times), and
+    the guide is exact at the requested steps."""
+    from barhinge.solver.branch import rigid_guide
+
+    cp = bh.families.miura(nx=3, ny=3, a=1.0, b=1.0, alpha=60.0)
+    z = int(bh.families.miura_layout(3, 3).interior_zigzag_edges[0])
+    model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=MAT)
+    fixed = np.zeros((model.n_nodes, 3), bool)
+    X0 = np.asarray(model.X0)
+    final = 40.0  # degrees at t = 1
+    t_probe = 0.0375  # inside the first step of both guides below (steps 8 and 16)
+    exact = rigid_guide(
+        model, bh.Actuators(edges=[z], targets_deg=[final * t_probe]), 1, fixed, X0
+    ).X[-1]
+    errors = []
+    for steps in (8, 16):
+        g = rigid_guide(model, bh.Actuators(edges=[z], targets_deg=[final]), steps, fixed, X0)
+        assert g is not None
+        np.testing.assert_allclose(g.at(2 / steps), g.X[2], atol=1e-14)
+        errors.append(float(np.abs(g.at(t_probe) - exact).max()))
+    assert errors[1] > 0.0
+    assert errors[0] / errors[1] > 10.0
