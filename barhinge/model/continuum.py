@@ -321,12 +321,20 @@ def _condensed(K: sp.spmatrix, keep: np.ndarray, drop: np.ndarray) -> np.ndarray
     if len(drop) == 0:
         return Kkk
     Kkd = K[keep][:, drop]
+    # singular to working precision when the LU factorisation's pivots span more than the
+    # precision: the solve's own signals (a rank warning, NaN) are not enough, as some
+    # releases return finite values of ~1e45 for a sliver 1e-12 high
+    X = np.full((len(drop), len(keep)), np.nan)
     with warnings.catch_warnings():
         warnings.simplefilter("error", spla.MatrixRankWarning)
         try:
-            X = spla.spsolve(sp.csc_matrix(K[drop][:, drop]), Kkd.T.toarray())
-        except spla.MatrixRankWarning:
-            X = np.full((len(drop), len(keep)), np.nan)
+            lu = spla.splu(sp.csc_matrix(K[drop][:, drop]))
+        except (RuntimeError, spla.MatrixRankWarning):
+            lu = None
+    if lu is not None:
+        pivots = np.abs(lu.U.diagonal())
+        if pivots.min() > len(pivots) * np.finfo(float).eps * pivots.max():
+            X = lu.solve(Kkd.T.toarray())
     if not np.all(np.isfinite(X)):
         raise ConfigError(
             "the continuum plate of a panel is singular with its corners held: a sliver "

@@ -148,3 +148,22 @@ def test_a_sliver_panel_is_a_named_error_not_a_stiffness_of_nan() -> None:
     sliver = np.array([[0, 0], [1, 0], [1, 1e-12], [0, 1e-12]], float)
     with pytest.raises(ConfigError, match="sliver"):
         cont.plate_corner_stiffness(sliver, mat)
+
+
+@pytest.mark.parametrize("height, singular", [(1e-2, False), (1e-4, False), (1e-6, True)])
+def test_thin_panels_condense_symmetric_or_are_refused(height: float, singular: bool) -> None:
+    """A condensed stiffness (a Schur complement of a symmetric matrix) is symmetric. Down
+    to panels 1e-4 high it is (to 1e-7); at 1e-6 the pivots of the condensation span more
+    than double precision, its result would be asymmetric by ~1e-3, and the panel is
+    refused as a sliver instead."""
+    from barhinge.errors import ConfigError
+
+    mat = Material(E=1e6, nu=0.3, t=0.01)
+    P = np.array([[0, 0], [1, 0], [1, height], [0, height]], float)
+    if singular:
+        with pytest.raises(ConfigError, match="sliver"):
+            cont.plate_corner_stiffness(P, mat)
+        return
+    S = cont.plate_corner_stiffness(P, mat)
+    assert np.all(np.isfinite(S))
+    assert np.abs(S - S.T).max() <= 1e-7 * np.abs(S).max()
