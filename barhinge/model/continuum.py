@@ -26,7 +26,6 @@ Meshes are small (a few hundred elements) so the tests stay fast. Whole-panel co
 
 from __future__ import annotations
 
-import warnings
 from typing import Any
 
 import numpy as np
@@ -313,6 +312,12 @@ def plate_corner_energy(
     return _solve_prescribed(K, D, np.asarray(corner_w, dtype=float))
 
 
+#: largest estimated relative error of a panel's condensed plate stiffness (``_condensed``);
+#: a panel whose condensation would exceed it is refused as a sliver (a quadrilateral
+#: 1e-4 as high as wide keeps ~5e-8, 1e-5 high ~6e-6)
+CONDENSATION_ERROR_MAX = 1e-6
+
+
 def _condensed(K: sp.spmatrix, keep: np.ndarray, drop: np.ndarray) -> np.ndarray:
     """Dense Schur complement of K on the dofs ``keep`` (the ``drop`` dofs condensed out,
     every other dof fixed at zero)."""
@@ -321,20 +326,25 @@ def _condensed(K: sp.spmatrix, keep: np.ndarray, drop: np.ndarray) -> np.ndarray
     if len(drop) == 0:
         return Kkk
     Kkd = K[keep][:, drop]
-    # singular to working precision when the LU factorisation's pivots span more than the
-    # precision: the solve's own signals (a rank warning, NaN) are not enough, as some
-    # releases return finite values of ~1e45 for a sliver 1e-12 high
+    # refused when the condensation would keep fewer than six digits: its relative error
+    # is about eps / (smallest / largest LU pivot) of the matrix scaled to a unit diagonal
+    # (free of the units of deflections and rotations, so of the panel's size); the
+    # solve's own signals (a rank warning, NaN) are not enough, as some releases return
+    # finite values of ~1e45 for a sliver 1e-12 high
     X = np.full((len(drop), len(keep)), np.nan)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", spla.MatrixRankWarning)
+    Kdd = sp.csc_matrix(K[drop][:, drop])
+    diag = Kdd.diagonal()
+    if np.all(diag > 0.0):
+        s = 1.0 / np.sqrt(diag)
+        scale = sp.diags(s)
         try:
-            lu = spla.splu(sp.csc_matrix(K[drop][:, drop]))
-        except (RuntimeError, spla.MatrixRankWarning):
+            lu = spla.splu(sp.csc_matrix(scale @ Kdd @ scale))
+        except RuntimeError:  # exactly singular
             lu = None
-    if lu is not None:
-        pivots = np.abs(lu.U.diagonal())
-        if pivots.min() > len(pivots) * np.finfo(float).eps * pivots.max():
-            X = lu.solve(Kkd.T.toarray())
+        if lu is not None:
+            pivots = np.abs(lu.U.diagonal())
+            if np.finfo(float).eps * pivots.max() < CONDENSATION_ERROR_MAX * pivots.min():
+                X = s[:, None] * lu.solve(s[:, None] * Kkd.T.toarray())
     if not np.all(np.isfinite(X)):
         raise ConfigError(
             "the continuum plate of a panel is singular with its corners held: a sliver "

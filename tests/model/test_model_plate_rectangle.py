@@ -150,12 +150,14 @@ def test_a_sliver_panel_is_a_named_error_not_a_stiffness_of_nan() -> None:
         cont.plate_corner_stiffness(sliver, mat)
 
 
-@pytest.mark.parametrize("height, singular", [(1e-2, False), (1e-4, False), (1e-6, True)])
+@pytest.mark.parametrize(
+    "height, singular", [(1e-2, False), (1e-4, False), (1e-6, True), (1e-12, True)]
+)
 def test_thin_panels_condense_symmetric_or_are_refused(height: float, singular: bool) -> None:
-    """A condensed stiffness (a Schur complement of a symmetric matrix) is symmetric. Down
-    to panels 1e-4 high it is (to 1e-7); at 1e-6 the pivots of the condensation span more
-    than double precision, its result would be asymmetric by ~1e-3, and the panel is
-    refused as a sliver instead."""
+    """A condensed stiffness (a Schur complement of a symmetric matrix) is symmetric: its
+    asymmetry measures the condensation's rounding error. Down to panels 1e-4 high it is
+    symmetric to 1e-7; at 1e-6 the condensation would keep three digits (asymmetric by
+    ~1e-3) and the panel is refused as a sliver instead."""
     from barhinge.errors import ConfigError
 
     mat = Material(E=1e6, nu=0.3, t=0.01)
