@@ -364,6 +364,13 @@ class PardisoBackend:
             return 0
         return 1024 * int(self._solver.iparm[16])
 
+    def analysis_bytes(self) -> int:
+        """Permanent memory of the ordering and symbolic analysis PARDISO keeps beside the
+        factor (bytes; its ``iparm(16)``); 0 before an analysis."""
+        if self._key is None:
+            return 0
+        return 1024 * int(self._solver.iparm[15])
+
     def release(self) -> None:
         """Free the numeric factor PARDISO holds (phase 0), keeping the ordering and analysis
         of the pattern: the next factorisation of the pattern is numeric only. Factors made

@@ -363,6 +363,7 @@ class BorderedSystem:
         penalty: float,
         factorize: bool = False,
         springs: tuple[np.ndarray, np.ndarray] | None = None,
+        release_values: bool = False,
     ) -> None:
         """Make ``A = K_ff + sum mu_a H_a + p G^T G`` (and G) the current operator.
 
@@ -371,6 +372,11 @@ class BorderedSystem:
         Factorises it in direct mode, when ``factorize`` is set, when there is no
         factorisation yet, or when the reuse policy asks for a fresh one. Raises
         SingularMatrixError when a factorisation finds A or the Schur complement singular.
+
+        ``release_values``: after a factorisation in direct mode, forget K's values where
+        nothing but the factor reads them until the next operator (:attr:`holds_values`
+        says whether they were kept); a caller that drops its own reference to K then
+        returns K's memory before it assembles the next tangent.
         """
         na = len(mu)
         g = terms.grad
@@ -396,6 +402,28 @@ class BorderedSystem:
         stale = self._krylov_cost > self._fact_cost
         if factorize or not self.reuse or self.direct is None or stale:
             self._factorize_current()
+            if release_values and not self.reuse:
+                self._forget_values()
+
+    @property
+    def holds_values(self) -> bool:
+        """Whether the current operator's values (K's, and what is built from them) are
+        kept after its factorisation (see ``release_values`` of :meth:`set_operator`)."""
+        return self._values is not None
+
+    def _forget_values(self) -> None:
+        """Drop the current operator's values (K's, the free submatrix ``A`` and the
+        released tangent's) where the factor alone gives every later solve and count: the
+        bordered factor with its Schur complement, or the factor of ``A`` with the Schur
+        complement of the actuators. Not where the released tangent's count factorises K
+        itself (the augmented bordered route), which reads them."""
+        direct = self.direct
+        if isinstance(direct, _KKTSolver) and not self._schur_counts:
+            return
+        if direct is None:
+            return
+        self._values = self._full = self._A = None
+        self._released = None
 
     def factorize(
         self, K: sp.csr_matrix, terms: ActuatorTerms, mu: np.ndarray, penalty: float

@@ -144,18 +144,35 @@ class SolveContext:
             return float(a)
         return penalty
 
-    def factorize(self, e: Evaluation, st: State, reuse: bool = False) -> None:
+    def factorize(
+        self, e: Evaluation, st: State, reuse: bool = False, keep_operator: bool = False
+    ) -> None:
         """Make the tangent at ``st`` the operator of the bordered system and factorise it
         (``reuse``: unless the system keeps an earlier factorisation as GMRES
-        preconditioner)."""
+        preconditioner). Unless ``keep_operator`` is set, the operator's values and ``e``'s
+        tangent are released where the factor alone serves every later solve (the next
+        tangent is then assembled without this one beside it); a later factorisation of
+        ``e`` assembles its tangent again."""
         self.system.row_scale = self.c_scale
+        if e.ev.K is None:  # released after an earlier factorisation: assembled again
+            e.ev = self.evaluate(st).ev
         check_finite_tangent(e.ev.K)  # NaN / inf never reach the factorisation
         springs = None
         if self.k_act is not None:
             springs = (e.mu_act, self.k_act)
         self.system.set_operator(
-            e.ev.K, e.terms, st.mu, self.penalty or 0.0, factorize=not reuse, springs=springs
+            e.ev.K,
+            e.terms,
+            st.mu,
+            self.penalty or 0.0,
+            factorize=not reuse,
+            springs=springs,
+            release_values=not keep_operator,
         )
+        if not self.system.holds_values and dataclasses.is_dataclass(e.ev):
+            # only the factor solves from here: K is not held beside the next tangent (242 MB
+            # at the 1 M DOFs of a 200 x 200 Miura); a later need assembles it again
+            e.ev = dataclasses.replace(cast(Any, e.ev), K=None)
 
     def factorize_or_fail(
         self, e: Evaluation, st: State, res: list[float], reuse: bool = False

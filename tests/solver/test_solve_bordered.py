@@ -211,3 +211,62 @@ def test_no_gmres_iterations_allowed_factorises_without_calling_gmres():
     np.testing.assert_allclose(
         np.concatenate([dx, dmu]), ref, rtol=0, atol=1e-8 * np.abs(ref).max()
     )
+
+
+@pytest.mark.parametrize("name", available_backends())
+def test_released_values_leave_solves_and_counts_to_the_factor(name):
+    """``release_values``: once factorised, the operator's values are let go where the factor
+    alone serves; solves and the stability counts are unchanged (dense reference), and the
+    next operator is built and factorised as before."""
+    K, terms, free, mu = _miura_system()
+    keep = BorderedSystem(get_backend(name), free, terms.dofs, Timer())
+    keep.set_operator(K, terms, mu, 50.0, factorize=True)
+    drop = BorderedSystem(get_backend(name), free, terms.dofs, Timer())
+    drop.set_operator(K, terms, mu, 50.0, factorize=True, release_values=True)
+    assert keep.holds_values
+    assert not drop.holds_values and drop.A is None
+    nf, na = int(free.sum()), len(mu)
+    rng = np.random.default_rng(4)
+    rx, rc = rng.standard_normal(nf), rng.standard_normal(na)
+    ref = np.linalg.solve(_dense_bordered(K, terms, free, mu), np.concatenate([rx, rc]))
+    dx, dmu = drop.solve(rx, rc)
+    np.testing.assert_allclose(np.concatenate([dx, dmu]), ref, rtol=0, atol=1e-8 * abs(ref).max())
+    assert drop.held_negative_eigenvalues() == keep.held_negative_eigenvalues()
+    assert drop.tangent_negative_eigenvalues() == keep.tangent_negative_eigenvalues()
+    # the next operator (another tangent) after a release: set, factorised and exact
+    K2, terms2, _, _ = _miura_system(nudge=1e-3)
+    drop.set_operator(K2, terms2, mu, 50.0, factorize=True, release_values=True)
+    ref2 = np.linalg.solve(_dense_bordered(K2, terms2, free, mu), np.concatenate([rx, rc]))
+    dx2, dmu2 = drop.solve(rx, rc)
+    np.testing.assert_allclose(
+        np.concatenate([dx2, dmu2]), ref2, rtol=0, atol=1e-8 * abs(ref2).max()
+    )
+
+
+def test_the_solver_lets_go_of_a_factorised_tangent_and_assembles_it_again_when_asked():
+    """``SolveContext.factorize`` releases the iterate's tangent once it is factorised (the
+    factor alone solves); factorising the same iterate again assembles it anew and solves
+    the same system."""
+    from barhinge.solver.context import SolveContext
+    from barhinge.solver.state import State
+
+    cp = bh.families.miura(2, 2, alpha=60.0, fold=30.0)
+    model = BarHingeModel.from_pattern(cp, "N5B8", fold_stiffness=0.1, bar_EA=1e3)
+    edges = miura_line_creases(cp)
+    scene = Scene(model, actuators=bh.Actuators(edges=edges, targets_deg=[40.0] * len(edges)))
+    ctx = SolveContext(scene)
+    ctx.make_system()
+    x = model.X0.ravel() + 1e-3 * np.random.default_rng(2).standard_normal(model.X0.size)
+    st = State(x, 0.01 * np.arange(1, len(edges) + 1), 0.0, 0.5)
+    e = ctx.evaluate(st)
+    K = e.ev.K.copy()
+    ctx.factorize(e, st)
+    assert e.ev.K is None and not ctx.system.holds_values
+    nf, na = int(ctx.free.sum()), len(edges)
+    rng = np.random.default_rng(5)
+    rx, rc = rng.standard_normal(nf), rng.standard_normal(na)
+    first = np.concatenate(ctx.system.solve(rx, rc))
+    ref = np.linalg.solve(_dense_bordered(K, e.terms, ctx.free, st.mu), np.concatenate([rx, rc]))
+    np.testing.assert_allclose(first, ref, rtol=0, atol=1e-8 * np.abs(ref).max())
+    ctx.factorize(e, st)  # the same iterate again: its tangent assembled anew
+    np.testing.assert_allclose(np.concatenate(ctx.system.solve(rx, rc)), first, rtol=1e-12)

@@ -71,7 +71,7 @@ def test_compliant_tangent_matches_finite_differences():
     x = path.X[-1].ravel() + 1e-3 * rng.normal(size=path.X[-1].size)
     st = State(x, np.zeros(0), 0.0, 0.6)
     e = ctx.evaluate(st)
-    ctx.factorize(e, st)
+    ctx.factorize(e, st, keep_operator=True)
     A = ctx.system.A.toarray()
     free = np.flatnonzero(ctx.free)
     h = 1e-6
