@@ -417,10 +417,7 @@ class BorderedSystem:
         bordered factor with its Schur complement, or the factor of ``A`` with the Schur
         complement of the actuators. Not where the released tangent's count factorises K
         itself (the augmented bordered route), which reads them."""
-        direct = self.direct
-        if isinstance(direct, _KKTSolver) and not self._schur_counts:
-            return
-        if direct is None:
+        if self.direct is None or (isinstance(self.direct, _KKTSolver) and not self._schur_counts):
             return
         self._values = self._full = self._A = None
         self._released = None

@@ -151,10 +151,10 @@ class SolveContext:
         (``reuse``: unless the system keeps an earlier factorisation as GMRES
         preconditioner). Unless ``keep_operator`` is set, the operator's values and ``e``'s
         tangent are released where the factor alone serves every later solve (the next
-        tangent is then assembled without this one beside it); a later factorisation of
-        ``e`` assembles its tangent again."""
+        tangent is then assembled without this one beside it). An ``e`` without its
+        tangent (evaluated without it, or released) has it assembled first."""
         self.system.row_scale = self.c_scale
-        if e.ev.K is None:  # released after an earlier factorisation: assembled again
+        if e.ev.K is None:  # evaluated without it, or released by an earlier factorisation
             e.ev = self.evaluate(st).ev
         check_finite_tangent(e.ev.K)  # NaN / inf never reach the factorisation
         springs = None

@@ -163,8 +163,6 @@ class _Driver:
                     new, e, dx_last = chord
                     n_chord += 1
                     continue
-            if e.ev.K is None:  # evaluated without tangent (convergence was expected)
-                e = ctx.evaluate(new)
             # the first correction always factorises: the predictor's bar forces change the
             # tangent too much for the previous factorisation to precondition it
             ctx.factorize_or_fail(e, new, res, reuse=n_iter > 0)

@@ -123,8 +123,6 @@ class InertiaMonitor:
         iterate before convergence), None if there was none."""
         ctx = self.ctx
         if exact:
-            if e.ev.K is None:  # evaluated without the tangent (force-only)
-                e = ctx.evaluate(st)
             try:
                 ctx.factorize(e, st)
             except SingularMatrixError as exc:
