@@ -33,8 +33,10 @@ from barhinge.errors import BarhingeError, ConvergenceError
 from barhinge.kinematics.path import RigidOptions, actuator_conflict, rigid_fold
 from barhinge.linalg.extrapolation import lagrange
 from barhinge.model.triangulate import quad_centres, triangulate
+from barhinge.results import FoldPath
 
 __all__ = [
+    "GUIDE_HEAD",
     "RigidGuide",
     "conflicting_actuators",
     "creases_against_assignment",
@@ -49,6 +51,9 @@ log = logging.getLogger(__name__)
 FLAT_START_TOL = 1e-6
 #: requested steps of the rigid fold that :meth:`RigidGuide.at` interpolates through (cubic)
 STENCIL = 4
+#: requested steps the guide folds where the actuators leave no free motion (only the first
+#: increment is predicted from it then): the states of the cubic over the first step
+GUIDE_HEAD = STENCIL - 1
 
 
 def is_flat(model: SolverModel) -> bool:
@@ -175,6 +180,7 @@ def rigid_guide(
     steps: int,
     fixed: np.ndarray,
     fixed_target: np.ndarray,
+    head: int | None = None,
 ) -> RigidGuide | None:
     """Rigid fold of the actuator schedule with the model's fold springs: the limit of the
     bar-and-hinge model as bars and panels become rigid, on the branch of the M/V
@@ -187,6 +193,12 @@ def rigid_guide(
     steps : int, requested steps of the scene.
     fixed : (n_nodes, 3) bool, supported or prescribed components.
     fixed_target : (n_nodes, 3) float, their positions (at the start).
+    head : int, optional
+        Fold only the first ``head`` requested steps, unless the actuators leave free
+        motions (then the whole schedule): the solver predicts only its first increment
+        from the guide where they leave none (``GUIDE_HEAD`` steps serve the cubic of
+        :meth:`RigidGuide.at` over that increment and its cut-backs). Default: the whole
+        schedule.
 
     Returns
     -------
@@ -200,15 +212,7 @@ def rigid_guide(
     why = []
     for triangulated in (False, True):
         try:
-            path = rigid_fold(
-                cp,
-                actuators,
-                steps=steps,
-                options=opt,
-                triangulated=triangulated,
-                fold_stiffness=w,
-                diagonal_stiffness=kb,
-            )
+            path = _rigid_schedule(cp, actuators, steps, head, opt, triangulated, w, kb)
         except ConvergenceError as exc:
             path = exc.last_state
             if path is None or path.n_states < 2:
@@ -236,6 +240,45 @@ def rigid_guide(
         "no rigid fold predicts the first increment off the flat start (%s)", "; ".join(why)
     )
     return None
+
+
+def _rigid_schedule(
+    cp: Any,
+    actuators: Actuators,
+    steps: int,
+    head: int | None,
+    opt: RigidOptions,
+    triangulated: bool,
+    fold_stiffness: np.ndarray,
+    diagonal_stiffness: float,
+) -> FoldPath:
+    """The rigid fold of the first ``head`` of the ``steps`` requested steps (the same
+    states as the whole schedule's: each step starts from the last), and of the whole
+    schedule where those leave free motions to the fold springs (or ``head`` is None or
+    not shorter)."""
+
+    def fold(act: Actuators, n: int) -> FoldPath:
+        return rigid_fold(
+            cp,
+            act,
+            steps=n,
+            options=opt,
+            triangulated=triangulated,
+            fold_stiffness=fold_stiffness,
+            diagonal_stiffness=diagonal_stiffness,
+        )
+
+    if head is None or head >= steps:
+        return fold(actuators, steps)
+    first = Actuators(
+        edges=actuators.edges,
+        table_deg=actuators.schedule(steps)[1 : head + 1],
+        stiffness=actuators.stiffness,
+    )
+    path = fold(first, head)  # a failure inside the head is the whole schedule's too
+    if path.meta.get("free_dof"):
+        return fold(actuators, steps)
+    return path
 
 
 def creases_against_assignment(

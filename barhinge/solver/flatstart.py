@@ -9,6 +9,7 @@ import logging
 from typing import Any
 
 from barhinge.solver.branch import (
+    GUIDE_HEAD,
     RigidGuide,
     conflicting_actuators,
     creases_against_assignment,
@@ -63,6 +64,7 @@ class FlatStart:
                 ctx.scene.steps,
                 ctx.fixed.reshape(-1, 3),
                 target.reshape(-1, 3),
+                head=GUIDE_HEAD,
             )
             self.record = (
                 self._guide.record

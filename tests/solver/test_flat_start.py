@@ -278,3 +278,35 @@ def test_rigid_guide_between_steps_is_the_cubic_through_the_rigid_fold():
         errors.append(float(np.abs(g.at(t_probe) - exact).max()))
     assert errors[1] > 0.0
     assert errors[0] / errors[1] > 10.0
+
+
+def test_rigid_guide_head_folds_the_first_steps_as_the_whole_schedule():
+    """Where the actuators leave no free motion the solver predicts only its first increment
+    from the rigid fold, so the guide folds only the first ``GUIDE_HEAD`` requested steps:
+    the same states as the whole schedule's (each step starts from the last) and the same
+    cubic over the first step. Where the actuators leave free motions (an under-actuated
+    Ron Resch sheet, whose later increments follow the guide) the whole schedule is folded."""
+    from barhinge.solver.branch import GUIDE_HEAD, rigid_guide
+
+    cp = bh.families.miura(nx=3, ny=3, a=1.0, b=1.0, alpha=60.0)
+    z = int(bh.families.miura_layout(3, 3).interior_zigzag_edges[0])
+    model = bh.BarHingeModel.from_pattern(cp, scheme="N5B8", material=MAT)
+    fixed = np.zeros((model.n_nodes, 3), bool)
+    X0 = np.asarray(model.X0)
+    acts = bh.Actuators(edges=[z], targets_deg=[40.0])
+    whole = rigid_guide(model, acts, 20, fixed, X0)
+    head = rigid_guide(model, acts, 20, fixed, X0, head=GUIDE_HEAD)
+    assert whole is not None and head is not None
+    assert whole.record["free_dof"] == 0 and whole.t_max == 1.0
+    assert len(head.X) == GUIDE_HEAD + 1 and head.t_max == GUIDE_HEAD / 20
+    np.testing.assert_allclose(head.X, whole.X[: GUIDE_HEAD + 1], atol=1e-12)
+    for t in (0.01, 0.025, 0.05):
+        np.testing.assert_allclose(head.at(t), whole.at(t), atol=1e-12)
+
+    resch = bh.families.resch(3, 3)
+    a = [int(e) for e in bh.dof(resch).mechanism.actuators][:1]
+    under = bh.Actuators(edges=a, targets_deg=0.5 * resch.fold_angles[a])
+    m = bh.BarHingeModel.from_pattern(resch, scheme="N5B8", material=MAT)
+    g = rigid_guide(m, under, 10, np.zeros((m.n_nodes, 3), bool), np.asarray(m.X0), head=2)
+    assert g is not None and g.record["free_dof"] > 0
+    assert g.t_max == 1.0 and len(g.X) == 11
