@@ -394,10 +394,11 @@ def fold_cmd(
 
     from barhinge.output.folder import check_output_folder
     from barhinge.output.run import picture_level, write_run
+    from barhinge.output.summary import iterate_text
     from barhinge.results import Interrupted
     from barhinge.scene import default_scene, load_scene
     from barhinge.solver.form import form_only_model, rigid_form
-    from barhinge.solver.newton import solve
+    from barhinge.solver.newton import IterationStatus, solve
 
     level = picture_level(pictures)  # a bad value stops before the solve
     scene = default_scene() if scene_file is None else load_scene(scene_file)
@@ -452,6 +453,7 @@ def fold_cmd(
         BarColumn(),
         TextColumn("step {task.completed}/{task.total}"),
         TimeElapsedColumn(),
+        TextColumn("{task.fields[detail]}", markup=False),
         console=err_console,
         disable=as_json,
     )
@@ -459,9 +461,18 @@ def fold_cmd(
     term.enter_context(_sigterm_as_interrupt())
     try:
         with bar:
-            task = bar.add_task("fold", total=scene.steps)
+            task = bar.add_task("fold", total=scene.steps, detail="")
+
+            def iterate(status: IterationStatus) -> None:
+                text = f"solving step {status.step}: {iterate_text(status)}"
+                bar.update(task, detail=text)
+
             try:
-                path = solve(scene, progress=lambda d, total, v: bar.update(task, completed=d))
+                path = solve(
+                    scene,
+                    progress=lambda d, total, v: bar.update(task, completed=d, detail=""),
+                    on_iteration=iterate,
+                )
             except (ConvergenceError, Interrupted) as exc:
                 part = exc.last_state
                 if part is not None:

@@ -96,6 +96,8 @@ def one(n: int, steps: int, material: str) -> dict:
     from bench_solver import bare_factorisation, miura_scene
 
     import barhinge as bh
+    from barhinge.output.summary import iterate_text
+    from barhinge.solver.state import IterationStatus
 
     t0 = time.perf_counter()
     sc = miura_scene(n, 0.0, steps, material=material)
@@ -112,7 +114,16 @@ def one(n: int, steps: int, material: str) -> dict:
             flush=True,
         )
 
-    path = bh.solve(sc, progress=progress)
+    def iterate(status: IterationStatus) -> None:
+        # the largest sheets take seconds per iterate: each one is shown as it goes
+        print(
+            f"[n={n} {material}] step {status.step}: {iterate_text(status)}  "
+            f"wall {time.perf_counter() - t0:.0f} s",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    path = bh.solve(sc, progress=progress, on_iteration=iterate if n >= 100 else None)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     tm = path.meta["timing"]
     its = int(path.meta["newton"]["total_iterations"])

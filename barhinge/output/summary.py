@@ -9,12 +9,15 @@ docs/outputs.md lists the fields and their units.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from barhinge.analysis.final_state import energy_split
 from barhinge.results import FoldPath
+
+if TYPE_CHECKING:
+    from barhinge.solver.state import IterationStatus
 
 __all__ = [
     "energy_share_text",
@@ -133,6 +136,23 @@ def energy_share_text(path: FoldPath) -> str:
     parts = (("folds", "fold"), ("panel bending", "bend"), ("bars", "bars"))
     shares = [(label, e[f"energy_fraction_{k}"]) for label, k in parts]
     return ", ".join(f"{label} {_percent(x)}" for label, x in shares if x is not None)
+
+
+def iterate_text(status: IterationStatus) -> str:
+    """The running iterate in one line for a progress display, e.g. "increment 1/4 of a
+    step, iterate 5, residual 3.2e+01, 2 redone shorter" (the increment only when shorter
+    than a step, the failures only when there were some)."""
+    parts = []
+    length = status.length
+    if 0.0 < length < 1.0 - 1e-9:
+        k = 1.0 / length
+        parts.append(f"increment 1/{k:.0f} of a step" if abs(k - round(k)) < 1e-6 * k
+                     else f"increment {length:.2g} of a step")  # fmt: skip
+    parts.append("predictor" if status.iteration == 0 else f"iterate {status.iteration}")
+    parts.append(f"residual {status.residual:.1e}")
+    if status.failed:
+        parts.append(f"{status.failed} redone shorter")
+    return ", ".join(parts)
 
 
 def flat_start_text(path: FoldPath) -> str:

@@ -63,7 +63,7 @@ def arc_increment(
     while True:
         rf = float(np.linalg.norm(e.r[free]))
         res.append(rf)
-        ctx.timer.n_iterations += 1
+        ctx.iterate(rf, new.lam)
         if not np.isfinite(rf):
             raise IncrementFailed("non-finite residual", res)
         if it > 1 and conv.converged(e, new, dx, _arc_correction(ctx, e, uh, tan1)):
@@ -149,7 +149,7 @@ def land_displacement(
         e = ctx.evaluate(new)
         rf = float(np.linalg.norm(e.r[free]))
         res.append(rf)
-        ctx.timer.n_iterations += 1
+        ctx.iterate(rf, new.lam)
         if not np.isfinite(rf):
             why = "non-finite residual"
             break

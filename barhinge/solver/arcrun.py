@@ -111,7 +111,8 @@ def run_arc_length(d: ArcDriver, progress: Progress | None) -> FoldPath:
             break
         scale = dl0 * shorter
         last: IncrementFailed | None = None
-        for _cut in range(o.max_cutbacks + 1):
+        for cut in range(o.max_cutbacks + 1):
+            ctx.begin_increment(n, steps, st.lam, scale / dl0, cut)
             try:
                 new, e_new, res, tan, sgn = arc_increment(
                     ctx, d.conv, st, e, scale, first_tan, prev_tan, sign, factored, watch

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
@@ -14,7 +15,7 @@ from barhinge._protocols import SolverModel
 from barhinge.linalg.backends import SingularMatrixError, get_backend
 from barhinge.solver.bordered import ActuatorTerms, BorderedSystem, Timer, actuator_terms
 from barhinge.solver.diagnose import check_finite_tangent
-from barhinge.solver.state import Evaluation, IncrementFailed, State
+from barhinge.solver.state import Evaluation, IncrementFailed, IterationStatus, State
 from barhinge.solver_options import SolverOptions
 
 if TYPE_CHECKING:
@@ -67,6 +68,11 @@ class SolveContext:
         self.force_floor: float | None = self.opts.force_floor
         self.penalty: float | None = None
         self.c_scale = 1.0
+        #: told of every iterate (:meth:`iterate`); None: nobody listens
+        self.on_iteration: Callable[[IterationStatus], None] | None = None
+        # (step, steps, value, length, failed) of the current increment, its iterates so far
+        self._increment: tuple[int, int, float, float, int] = (0, 0, 0.0, 1.0, 0)
+        self._n_iterate = 0
 
     def make_system(self) -> BorderedSystem:
         """The bordered system of this problem (after the scene checks)."""
@@ -101,6 +107,28 @@ class SolveContext:
     def fixed_coords(self, t: float) -> np.ndarray:
         """Coordinates of the fixed DOFs at path parameter t, length."""
         return self.X0.ravel()[self.fixed] + t * self.u_pres[self.fixed]
+
+    # ------------------------------------------------------------ live progress
+    def begin_increment(
+        self, step: int, steps: int, value: float, length: float, failed: int
+    ) -> None:
+        """An increment starts: requested ``step`` of ``steps``, aiming at the path
+        parameter ``value``, ``length`` a whole step's (see :class:`IterationStatus`), after
+        ``failed`` failed increments of the step."""
+        self._increment = (step, steps, value, length, failed)
+        self._n_iterate = 0
+
+    def iterate(self, residual: float, value: float | None = None) -> None:
+        """Count one iterate of the current increment, whose free force residual norm is
+        ``residual`` (``value``: its path parameter or load factor, if not the increment's
+        aim), and tell ``on_iteration``."""
+        self.timer.n_iterations += 1
+        if self.on_iteration is not None:
+            step, steps, aim, length, failed = self._increment
+            v = aim if value is None else float(value)
+            status = IterationStatus(step, steps, v, length, self._n_iterate, residual, failed)
+            self.on_iteration(status)
+        self._n_iterate += 1
 
     # ------------------------------------------------------------ evaluation
     def evaluate(self, st: State, tangent: bool = True) -> Evaluation:

@@ -29,7 +29,14 @@ from barhinge.solver.diagnose import check as check_scene
 from barhinge.solver.flatstart import FlatStart
 from barhinge.solver.records import build_path, make_record
 from barhinge.solver.stability import InertiaMonitor
-from barhinge.solver.state import Evaluation, IncrementFailed, State, StepRecord, StepStats
+from barhinge.solver.state import (
+    Evaluation,
+    IncrementFailed,
+    IterationStatus,
+    State,
+    StepRecord,
+    StepStats,
+)
 from barhinge.solver.work import WORK_TOLERANCE, WorkIntegrator
 from barhinge.solver_options import SolverOptions
 
@@ -52,7 +59,7 @@ CHORD_CONTRACTION = 0.1
 if TYPE_CHECKING:
     from barhinge.scene import Scene
 
-__all__ = ["WORK_TOLERANCE", "Progress", "solve"]
+__all__ = ["WORK_TOLERANCE", "IterationStatus", "Progress", "solve"]
 
 log = logging.getLogger(__name__)
 
@@ -135,7 +142,7 @@ class _Driver:
         while True:
             rf = float(np.linalg.norm(e.r[free]))
             res.append(rf)
-            ctx.timer.n_iterations += 1
+            ctx.iterate(rf)
             if not np.isfinite(rf) or not np.all(np.isfinite(e.c)):
                 raise IncrementFailed("non-finite residual", res)
 
@@ -408,6 +415,7 @@ class _Driver:
                 h_try = min(h, t_goal - st.t)
                 t1 = t_goal if h_try >= t_goal - st.t - 1e-12 * h0 else st.t + h_try
                 self.inertia.inc_serial = timer.n_factorizations
+                self.ctx.begin_increment(s, steps, t1, (t1 - st.t) / h0, n_failed)
                 try:
                     new, e_new, res = self.increment(st, t1, t1)
                 except IncrementFailed as f:
@@ -493,7 +501,11 @@ class _Driver:
 
 
 @threads_for_sparse
-def solve(scene: Scene, progress: Progress | None = None) -> FoldPath:
+def solve(
+    scene: Scene,
+    progress: Progress | None = None,
+    on_iteration: Callable[[IterationStatus], None] | None = None,
+) -> FoldPath:
     """Solve a scene along its path; returns a :class:`~barhinge.results.FoldPath`.
 
     Parameters
@@ -501,6 +513,10 @@ def solve(scene: Scene, progress: Progress | None = None) -> FoldPath:
     scene : Scene
     progress : callable (done, total, value) -> None, optional
         Called after every requested step (value = path parameter or load factor).
+    on_iteration : callable (IterationStatus) -> None, optional
+        Called at every iterate (the predictor and each correction) with the step, the
+        increment's length, the iterate's number and its force residual: a live display
+        of long steps (``barhinge fold`` shows it beside its progress bar).
 
     Returns
     -------
@@ -524,6 +540,7 @@ def solve(scene: Scene, progress: Progress | None = None) -> FoldPath:
             "barhinge.seed_imperfection(scene) before solving (barhinge fold does)"
         )
     d = _Driver(scene)
+    d.ctx.on_iteration = on_iteration
     try:
         if scene.control == "arc_length":
             return d.run_arc_length(progress)

@@ -1,7 +1,8 @@
 """The states of the Newton driver: a converged or trial state (:class:`State`), everything
 evaluated at it (:class:`Evaluation`), the failure of one increment
-(:class:`IncrementFailed`), and the record of a converged state kept for the
-:class:`~barhinge.results.FoldPath` (:class:`StepRecord`, :class:`StepStats`)."""
+(:class:`IncrementFailed`), the record of a converged state kept for the
+:class:`~barhinge.results.FoldPath` (:class:`StepRecord`, :class:`StepStats`), and what a
+live display is told of every iterate (:class:`IterationStatus`)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,14 @@ import numpy as np
 from barhinge._protocols import ModelEvaluation
 from barhinge.solver.bordered import ActuatorTerms
 
-__all__ = ["Evaluation", "IncrementFailed", "State", "StepRecord", "StepStats"]
+__all__ = [
+    "Evaluation",
+    "IncrementFailed",
+    "IterationStatus",
+    "State",
+    "StepRecord",
+    "StepStats",
+]
 
 
 @dataclasses.dataclass
@@ -84,3 +92,36 @@ class StepStats:
     factorizations: int  # all factorisations
     inertia_factorizations: int  # those made to confirm the inertia at the state
     chord: int = 0  # chord corrections kept (options.corrector = "chord")
+
+
+@dataclasses.dataclass(frozen=True)
+class IterationStatus:
+    """One iterate of a running solve, as ``bh.solve(..., on_iteration=...)`` reports it
+    (a live display of a long step: at a million DOFs an iterate takes seconds).
+
+    Attributes
+    ----------
+    step : int
+        Requested step being solved (1-based; arc length: the increment's number).
+    steps : int
+        Requested steps of the scene.
+    value : float
+        Path parameter of the iterate (the load factor under load control and arc length).
+    length : float
+        The increment's length over a whole step's (parameter control: 1, or 1/2, 1/4, ...
+        after cut-backs; arc length: over the first increment's arc length).
+    iteration : int
+        The iterate within its increment: 0 for the predictor, then one per correction.
+    residual : float
+        Norm of the force residual on the free DOFs at the iterate (force).
+    failed : int
+        Increments of this step that failed and were redone shorter so far.
+    """
+
+    step: int
+    steps: int
+    value: float
+    length: float
+    iteration: int
+    residual: float
+    failed: int

@@ -208,12 +208,12 @@ def test_fold_interrupted_writes_partial_results_and_exits_130(tmp_path, monkeyp
 
     real = newton.solve
 
-    def interrupted_solve(scene, progress=None):
+    def interrupted_solve(scene, progress=None, on_iteration=None):
         def stop(done, total, value):
             if done == 2:
                 raise KeyboardInterrupt
 
-        return real(scene, progress=stop)
+        return real(scene, progress=stop, on_iteration=on_iteration)
 
     monkeypatch.setattr(newton, "solve", interrupted_solve)
     out = tmp_path / "out"

@@ -128,11 +128,11 @@ signal.signal(signal.SIGINT, signal.default_int_handler)
 real = newton.solve
 
 
-def solve(scene, progress=None):
+def solve(scene, progress=None, on_iteration=None):
     def at_step(done, total, value):
         if done == 3:  # a real SIGINT through Python's own handler, as Ctrl-C sends it
             os.kill(os.getpid(), signal.SIGINT)
-    return real(scene, progress=at_step)
+    return real(scene, progress=at_step, on_iteration=on_iteration)
 
 
 newton.solve = solve
