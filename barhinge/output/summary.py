@@ -140,8 +140,8 @@ def energy_share_text(path: FoldPath) -> str:
 
 def iterate_text(status: IterationStatus) -> str:
     """The running iterate in one line for a progress display, e.g. "increment 1/4 of a
-    step, iterate 5, residual 3.2e+01, 2 redone shorter" (the increment only when shorter
-    than a step, the failures only when there were some)."""
+    step, iterate 5, residual 3.2e+01, after 2 failed increments" (the increment only when
+    shorter than a step, the failures of the step only when there were some)."""
     parts = []
     length = status.length
     if 0.0 < length < 1.0 - 1e-9:
@@ -151,7 +151,7 @@ def iterate_text(status: IterationStatus) -> str:
     parts.append("predictor" if status.iteration == 0 else f"iterate {status.iteration}")
     parts.append(f"residual {status.residual:.1e}")
     if status.failed:
-        parts.append(f"{status.failed} redone shorter")
+        parts.append(f"after {status.failed} failed increment{'s' * (status.failed > 1)}")
     return ", ".join(parts)
 
 

@@ -33,6 +33,7 @@ from barhinge.errors import BarhingeError, ConvergenceError
 from barhinge.kinematics.path import RigidOptions, actuator_conflict, rigid_fold
 from barhinge.linalg.extrapolation import lagrange
 from barhinge.model.triangulate import quad_centres, triangulate
+from barhinge.pattern.crease import CreasePattern
 from barhinge.results import FoldPath
 
 __all__ = [
@@ -243,7 +244,7 @@ def rigid_guide(
 
 
 def _rigid_schedule(
-    cp: Any,
+    cp: CreasePattern,
     actuators: Actuators,
     steps: int,
     head: int | None,

@@ -115,7 +115,8 @@ class IterationStatus:
     residual : float
         Norm of the force residual on the free DOFs at the iterate (force).
     failed : int
-        Increments of this step that failed and were redone shorter so far.
+        Increments of this step that failed so far (each redone shorter, or once at the
+        same length from the tangent predictor).
     """
 
     step: int

@@ -108,12 +108,13 @@ def test_iterate_text_names_the_shortened_increment_and_the_failures():
     s = IterationStatus(step=3, steps=50, value=0.05, length=0.25, iteration=5,
                         residual=32.0, failed=2)  # fmt: skip
     assert (
-        iterate_text(s) == "increment 1/4 of a step, iterate 5, residual 3.2e+01, 2 redone shorter"
+        iterate_text(s)
+        == "increment 1/4 of a step, iterate 5, residual 3.2e+01, after 2 failed increments"
     )
     whole = IterationStatus(3, 50, 0.06, 1.0, 0, 1.5e-3, 0)
     assert iterate_text(whole) == "predictor, residual 1.5e-03"
     arc = IterationStatus(7, 20, 0.4, 0.9 * 0.5, 2, 1e-9, 1)
     assert (
         iterate_text(arc)
-        == "increment 0.45 of a step, iterate 2, residual 1.0e-09, 1 redone shorter"
+        == "increment 0.45 of a step, iterate 2, residual 1.0e-09, after 1 failed increment"
     )
