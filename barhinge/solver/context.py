@@ -77,7 +77,7 @@ class SolveContext:
     def make_system(self) -> BorderedSystem:
         """The bordered system of this problem (after the scene checks)."""
         self.backend = get_backend(self.opts.linear_solver)
-        terms0 = actuator_terms(self.model, self.X0, self.hinges)
+        terms0 = actuator_terms(self.model, self.X0, self.hinges, hessians=False)
         self.system = BorderedSystem(
             self.backend,
             self.free,
@@ -138,7 +138,8 @@ class SolveContext:
         tangent = tangent or self.force_floor is None or self.penalty is None
         ev = self.model.evaluate(X, tangent=tangent)
         self.timer.n_force_only += not tangent
-        terms = actuator_terms(self.model, X, self.hinges)
+        # a residual alone needs no actuator Hessians (factorize adds them when needed)
+        terms = actuator_terms(self.model, X, self.hinges, hessians=tangent)
         P = self.P
         if self.follower is not None:
             P = P + self.follower.force(self.model, X)
@@ -182,8 +183,10 @@ class SolveContext:
         tangent is then assembled without this one beside it). An ``e`` without its
         tangent (evaluated without it, or released) has it assembled first."""
         self.system.row_scale = self.c_scale
-        if e.ev.K is None:  # evaluated without it, or released by an earlier factorisation
-            e.ev = self.evaluate(st).ev
+        if e.ev.K is None or e.terms.hess is None:
+            # evaluated without the tangent, or released by an earlier factorisation
+            fresh = self.evaluate(st)
+            e.ev, e.terms = fresh.ev, fresh.terms
         check_finite_tangent(e.ev.K)  # NaN / inf never reach the factorisation
         springs = None
         if self.k_act is not None:

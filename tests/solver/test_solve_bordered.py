@@ -270,3 +270,37 @@ def test_the_solver_lets_go_of_a_factorised_tangent_and_assembles_it_again_when_
     np.testing.assert_allclose(first, ref, rtol=0, atol=1e-8 * np.abs(ref).max())
     ctx.factorize(e, st)  # the same iterate again: its tangent assembled anew
     np.testing.assert_allclose(np.concatenate(ctx.system.solve(rx, rc)), first, rtol=1e-12)
+
+
+def test_a_residual_evaluation_skips_the_actuator_hessians_and_factorize_adds_them():
+    """A residual needs no actuator Hessians: an evaluation without the tangent gives the
+    same residual, constraint residual and constraint Jacobian as a full one (angles and
+    gradients from the gradient kernel alone) and no Hessians. Factorising that iterate
+    evaluates the tangent and the Hessians first: its solves are the dense bordered
+    system's, which adds ``mu_a H_a`` from the full evaluation's Hessians."""
+    from barhinge.solver.context import SolveContext
+    from barhinge.solver.state import State
+
+    cp = bh.families.miura(2, 2, alpha=60.0, fold=30.0)
+    model = BarHingeModel.from_pattern(cp, "N5B8", fold_stiffness=0.1, bar_EA=1e3)
+    edges = miura_line_creases(cp)
+    scene = Scene(model, actuators=bh.Actuators(edges=edges, targets_deg=[40.0] * len(edges)))
+    ctx = SolveContext(scene)
+    ctx.make_system()
+    x = model.X0.ravel() + 1e-3 * np.random.default_rng(3).standard_normal(model.X0.size)
+    st = State(x, 0.01 * np.arange(1, len(edges) + 1), 0.0, 0.5)
+    full = ctx.evaluate(st)
+    light = ctx.evaluate(st, tangent=False)
+    assert light.ev.K is None and light.terms.hess is None and full.terms.hess is not None
+    np.testing.assert_array_equal(light.r, full.r)
+    np.testing.assert_array_equal(light.c, full.c)
+    assert abs(light.terms.G - full.terms.G).max() == 0.0
+    ctx.factorize(light, st)
+    assert light.terms.hess is not None
+    nf, na = int(ctx.free.sum()), len(edges)
+    rng = np.random.default_rng(7)
+    rx, rc = rng.standard_normal(nf), rng.standard_normal(na)
+    got = np.concatenate(ctx.system.solve(rx, rc))
+    dense = _dense_bordered(full.ev.K, full.terms, ctx.free, st.mu)
+    ref = np.linalg.solve(dense, np.concatenate([rx, rc]))
+    np.testing.assert_allclose(got, ref, rtol=0, atol=1e-8 * np.abs(ref).max())
