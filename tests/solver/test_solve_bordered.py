@@ -243,10 +243,9 @@ def test_released_values_leave_solves_and_counts_to_the_factor(name):
     )
 
 
-def test_the_solver_lets_go_of_a_factorised_tangent_and_assembles_it_again_when_asked():
-    """``SolveContext.factorize`` releases the iterate's tangent once it is factorised (the
-    factor alone solves); factorising the same iterate again assembles it anew and solves
-    the same system."""
+def _miura_context(seed: int):
+    """The solve context of a 2 x 2 Miura sheet driven by its line creases, and a state near
+    its reference geometry (coordinates perturbed by 1e-3, small multipliers)."""
     from barhinge.solver.context import SolveContext
     from barhinge.solver.state import State
 
@@ -256,8 +255,16 @@ def test_the_solver_lets_go_of_a_factorised_tangent_and_assembles_it_again_when_
     scene = Scene(model, actuators=bh.Actuators(edges=edges, targets_deg=[40.0] * len(edges)))
     ctx = SolveContext(scene)
     ctx.make_system()
-    x = model.X0.ravel() + 1e-3 * np.random.default_rng(2).standard_normal(model.X0.size)
+    x = model.X0.ravel() + 1e-3 * np.random.default_rng(seed).standard_normal(model.X0.size)
     st = State(x, 0.01 * np.arange(1, len(edges) + 1), 0.0, 0.5)
+    return ctx, st, edges
+
+
+def test_the_solver_lets_go_of_a_factorised_tangent_and_assembles_it_again_when_asked():
+    """``SolveContext.factorize`` releases the iterate's tangent once it is factorised (the
+    factor alone solves); factorising the same iterate again assembles it anew and solves
+    the same system."""
+    ctx, st, edges = _miura_context(seed=2)
     e = ctx.evaluate(st)
     K = e.ev.K.copy()
     ctx.factorize(e, st)
@@ -278,17 +285,7 @@ def test_a_residual_evaluation_skips_the_actuator_hessians_and_factorize_adds_th
     gradients from the gradient kernel alone) and no Hessians. Factorising that iterate
     evaluates the tangent and the Hessians first: its solves are the dense bordered
     system's, which adds ``mu_a H_a`` from the full evaluation's Hessians."""
-    from barhinge.solver.context import SolveContext
-    from barhinge.solver.state import State
-
-    cp = bh.families.miura(2, 2, alpha=60.0, fold=30.0)
-    model = BarHingeModel.from_pattern(cp, "N5B8", fold_stiffness=0.1, bar_EA=1e3)
-    edges = miura_line_creases(cp)
-    scene = Scene(model, actuators=bh.Actuators(edges=edges, targets_deg=[40.0] * len(edges)))
-    ctx = SolveContext(scene)
-    ctx.make_system()
-    x = model.X0.ravel() + 1e-3 * np.random.default_rng(3).standard_normal(model.X0.size)
-    st = State(x, 0.01 * np.arange(1, len(edges) + 1), 0.0, 0.5)
+    ctx, st, edges = _miura_context(seed=3)
     full = ctx.evaluate(st)
     light = ctx.evaluate(st, tangent=False)
     assert light.ev.K is None and light.terms.hess is None and full.terms.hess is not None
