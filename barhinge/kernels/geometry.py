@@ -46,6 +46,8 @@ __all__ = [
     "bar_lengths",
     "bar_strain",
     "bar_strain_derivatives",
+    "bar_strain_gradient",
+    "bar_strain_hessian",
     "hinge_angle",
     "hinge_angle_gradient",
     "hinge_angle_gradient_t",
@@ -74,6 +76,34 @@ def bar_strain(
     return (np.sqrt(LL) - L0) / L0
 
 
+def bar_strain_gradient(
+    X: np.ndarray, bars: np.ndarray, L0: np.ndarray, measure: StrainMeasure = "green"
+) -> tuple[np.ndarray, np.ndarray]:
+    """Strain of every bar and its derivative: ``(eps (n_bars,), d (n_bars, 3))`` with
+    ``d = d eps / d x_b`` (``d eps / d x_a = -d``); see :func:`bar_strain_derivatives`."""
+    dx = X[bars[:, 1]] - X[bars[:, 0]]
+    LL = np.einsum("ni,ni->n", dx, dx)
+    if measure == "green":
+        inv = 1.0 / (L0 * L0)
+        return 0.5 * (LL * inv - 1.0), dx * inv[:, None]
+    L = np.sqrt(LL)
+    return L / L0 - 1.0, dx / (L * L0)[:, None]
+
+
+def bar_strain_hessian(
+    d: np.ndarray, eps: np.ndarray, L0: np.ndarray, measure: StrainMeasure = "green"
+) -> np.ndarray:
+    """(n, 3, 3) ``d^2 eps / d x_b^2`` of bars from their strain ``eps`` (n,) and its
+    derivative ``d`` (n, 3) (:func:`bar_strain_gradient`): the assembly computes it for one
+    chunk of bars at a time."""
+    eye = np.broadcast_to(np.eye(3), (len(d), 3, 3))
+    if measure == "green":
+        return eye / (L0 * L0)[:, None, None]
+    e = d * L0[:, None]  # the unit bar direction
+    L = (1.0 + eps) * L0
+    return (eye - e[:, :, None] * e[:, None, :]) / (L * L0)[:, None, None]
+
+
 def bar_strain_derivatives(
     X: np.ndarray, bars: np.ndarray, L0: np.ndarray, measure: StrainMeasure = "green"
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -89,22 +119,8 @@ def bar_strain_derivatives(
     Green-Lagrange: ``d = (x_b - x_a) / L0^2``, ``B = I / L0^2``. Engineering:
     ``d = e / L0`` (``e`` the unit bar direction), ``B = (I - e e^T) / (L L0)``.
     """
-    dx = X[bars[:, 1]] - X[bars[:, 0]]
-    LL = np.einsum("ni,ni->n", dx, dx)
-    n = len(bars)
-    eye = np.broadcast_to(np.eye(3), (n, 3, 3))
-    if measure == "green":
-        inv = 1.0 / (L0 * L0)
-        eps = 0.5 * (LL * inv - 1.0)
-        d = dx * inv[:, None]
-        B = eye * inv[:, None, None]
-        return eps, d, B
-    L = np.sqrt(LL)
-    e = dx / L[:, None]
-    eps = L / L0 - 1.0
-    d = e / L0[:, None]
-    B = (eye - e[:, :, None] * e[:, None, :]) / (L * L0)[:, None, None]
-    return eps, d, B
+    eps, d = bar_strain_gradient(X, bars, L0, measure)
+    return eps, d, bar_strain_hessian(d, eps, L0, measure)
 
 
 # -------------------------------------------------------------------------------- hinges

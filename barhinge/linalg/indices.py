@@ -5,7 +5,10 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["index_dtype", "pattern_positions"]
+__all__ = ["gather_into", "index_dtype", "pattern_positions"]
+
+#: entries gathered at a time by :func:`gather_into`
+GATHER_CHUNK = 1 << 20
 
 
 def index_dtype(*counts: int) -> type[np.signedinteger]:
@@ -37,3 +40,16 @@ def pattern_positions(
     ordinals.has_canonical_format = True
     found = ordinals[rows, cols]
     return np.asarray(found, dtype=np.int64).ravel() - 1
+
+
+def gather_into(values: np.ndarray, index: np.ndarray, out: np.ndarray) -> np.ndarray:
+    """``out[:] = values[index]`` (``index`` valid: built by the caller's own maps) in
+    chunks of ``GATHER_CHUNK`` entries, and ``out``.
+
+    ``numpy.take(..., out=out)`` buffers its whole output in its default mode (a second
+    array of ``out``'s size: 125 MB for the bordered matrix of a 200 x 200 Miura, beside
+    the factor held): chunk by chunk, the temporaries stay below 10 MB."""
+    for s in range(0, len(index), GATHER_CHUNK):
+        e = s + GATHER_CHUNK
+        np.take(values, index[s:e], out=out[s:e], mode="clip")
+    return out

@@ -26,12 +26,14 @@ from barhinge.assembly import Assembler, PackedRows
 from barhinge.errors import ConfigError
 from barhinge.kernels.geometry import (
     bar_strain,
-    bar_strain_derivatives,
+    bar_strain_gradient,
+    bar_strain_hessian,
     hinge_angle,
     hinge_angle_gradient_t,
     hinge_energy_hessian_packed,
 )
 from barhinge.kernels.laws import bar_linear, hinge_linear, hinge_penetration
+from barhinge.linalg.heap import release_free_heap
 from barhinge.model.calibrate import (
     BAR_CALIBRATIONS,
     BEND_COEFFICIENT_F17,
@@ -322,7 +324,7 @@ class BarHingeModel:
                     f"the model has non-finite {what}: the pattern's size or the material "
                     "constants overflow floating point"
                 )
-        return cls(
+        model = cls(
             pattern=cp,
             scheme=scheme,
             material=mat,
@@ -347,6 +349,8 @@ class BarHingeModel:
                 "bend_coefficient": bend_coefficient if bend_calibration == "filipov" else None,
             },
         )
+        release_free_heap(model.n_dof)  # the construction's temporaries
+        return model
 
     def with_(self, **changes: Any) -> BarHingeModel:
         """A new model with some fields replaced (arrays are validated for length)."""
@@ -432,7 +436,9 @@ class BarHingeModel:
         # product per evaluation (:meth:`_add_pair_tangent`), not from per-pair element
         # matrices (up to 231 values per pair, most of a refined panel's memory)
         pairs = [pair_nodes(self.hinges, self.hinge_pairs)] if len(self.hinge_pairs) else []
-        return Assembler(self.n_nodes, [self.bars, self.hinges], pattern_groups=pairs)
+        asm = Assembler(self.n_nodes, [self.bars, self.hinges], pattern_groups=pairs)
+        release_free_heap(self.n_dof)  # its construction's temporaries
+        return asm
 
     def release_assembler(self) -> int:
         """Drop the cached :attr:`assembler` (its scatter maps and pattern); the next
@@ -554,29 +560,32 @@ class BarHingeModel:
         """
         X = self._check_X(X)
         bars, hinges = self.bars, self.hinges
-        eps, d, B = bar_strain_derivatives(X, bars, self.bar_L0, self.strain)
+        eps, d = bar_strain_gradient(X, bars, self.bar_L0, self.strain)
         S, dS, Wb = self.bar_law(eps)
         asm = self.assembler
         law = self._hinge_law
         if len(self.hinge_pairs):
             law = functools.partial(law, pair_moment=self._pair_moment(hinge_angle(X, hinges)))
-        K = None
+        K = force = None
         if tangent:
             nh = len(hinges)
             rho, M, Kt, Wh = (np.empty(nh) for _ in range(4))
             g = np.empty((12, nh))
             XT = np.ascontiguousarray(X.T)
-            dT = np.ascontiguousarray(d.T)
+            L0, strain = self.bar_L0, self.strain
 
             def fill(group: int, sl: slice, rows: PackedRows) -> None:
                 """The packed upper triangles of the elements ``sl`` of a group."""
                 if group == 0:
                     # bar: [[k, -k], [-k, k]] with k = S'' d d^T + S B, packed upper
-                    # triangle of 6x6; the 6 distinct entries of the symmetric 3x3 k
+                    # triangle of 6x6; the 6 distinct entries of the symmetric 3x3 k. B and
+                    # d's rows are made for this chunk only (not held for all bars)
+                    dT = np.ascontiguousarray(d[sl].T)
+                    B = bar_strain_hessian(d[sl], eps[sl], L0[sl], strain)
                     for q, (a, b) in enumerate(_SYM3):
                         row = rows[_BAR_FIRST[q]]
-                        np.multiply(dS[sl] * dT[a, sl], dT[b, sl], out=row)
-                        row += S[sl] * B[sl, a, b]
+                        np.multiply(dS[sl] * dT[a], dT[b], out=row)
+                        row += S[sl] * B[:, a, b]
                     for p_, (q, sgn) in enumerate(zip(_BAR_Q, _BAR_SIGN, strict=True)):
                         if p_ != _BAR_FIRST[q]:
                             np.multiply(rows[_BAR_FIRST[q]], sgn, out=rows[p_])
@@ -587,7 +596,13 @@ class BarHingeModel:
                     rho[sl], M[sl], Kt[sl], Wh[sl], g[:, sl] = out[:5]
 
             sums = asm.block_sums_filled(fill)  # one chunk of element values at a time
-            del B, XT, dT  # not held beside the tangent's values
+            del XT
+            release_free_heap(self.n_dof)  # the chunks' temporaries, before K's values
+            if not len(self.hinge_pairs):
+                # the force first: the hinge gradients (12 floats a hinge) are not held
+                # beside the tangent's values while they are gathered
+                force = self._element_force(S, d, g, M)
+                del g
             K = asm.matrix_from_sums(sums)
             del sums
             if len(self.hinge_pairs):
@@ -597,9 +612,8 @@ class BarHingeModel:
         else:
             rho, g = hinge_angle_gradient_t(X, hinges)
             M, Kt, Wh = self._hinge_law(rho)
-        fb = (S[:, None] * d).T  # (3, nb)
-        fe_bar = np.concatenate([-fb, fb], axis=0)
-        force = asm.force([fe_bar, np.multiply(g, M, out=g)])  # g is not needed after this
+        if force is None:
+            force = self._element_force(S, d, g, M)
         f = self._is_fold
         return Evaluation(
             energy_bars=float(Wb.sum()),
@@ -612,6 +626,15 @@ class BarHingeModel:
             hinge_angle=rho,
             hinge_moment=M,
         )
+
+    def _element_force(
+        self, S: np.ndarray, d: np.ndarray, g: np.ndarray, M: np.ndarray
+    ) -> np.ndarray:
+        """(n_dof,) internal force of the bars (``dW/d eps`` ``S``, strain derivative ``d``)
+        and hinges (moments ``M``, angle gradients ``g`` (12, n_hinges), overwritten)."""
+        fb = (S[:, None] * d).T  # (3, nb)
+        fe_bar = np.concatenate([-fb, fb], axis=0)
+        return self.assembler.force([fe_bar, np.multiply(g, M, out=g)])
 
     def energy(self, X: np.ndarray) -> float:
         """Total stored energy at ``X``."""

@@ -45,7 +45,8 @@ import scipy.sparse.linalg as spla
 from barhinge._protocols import SolverModel
 from barhinge.kernels.geometry import hinge_angle_gradient_t
 from barhinge.linalg.backends import LinearBackend, SingularMatrixError
-from barhinge.linalg.indices import index_dtype, pattern_positions
+from barhinge.linalg.heap import release_free_heap
+from barhinge.linalg.indices import gather_into, index_dtype, pattern_positions
 from barhinge.linalg.inertia import InertiaCounter
 
 __all__ = ["ActuatorTerms", "BorderedSystem", "Timer", "actuator_terms", "hinge_derivatives"]
@@ -487,7 +488,7 @@ class BorderedSystem:
         indices, indptr, shape = self._kkt_pattern
         if self._kkt_data is None or len(self._kkt_data) != len(indices):
             self._kkt_data = np.empty(len(indices))
-        data = self._values.take(self._kkt_gather, out=self._kkt_data)
+        data = gather_into(self._values, self._kkt_gather, self._kkt_data)
         if len(self._blocks):  # the actuator blocks, added here: no copy of K's values
             assert self._kkt_blk is not None  # set with the pattern
             entry, at = self._kkt_blk
@@ -532,7 +533,9 @@ class BorderedSystem:
             # Schur complement instead, which names the cause (redundant actuators) or, if
             # only the bordered pivoting struggled, solves exactly.
             t_start = time.perf_counter()
-        self.factor = self.backend.factorize(self.A)
+        A = self.A
+        release_free_heap(self.n_dof)
+        self.factor = self.backend.factorize(A)
         self.timer.factorize += time.perf_counter() - t_start
         self.timer.n_factorizations += 1
         Z = S_inv = None
@@ -669,7 +672,10 @@ class BorderedSystem:
         # the last operator's values (kept for its released count) are not held through
         # the factorisation's own peak (242 MB at the 1 M DOFs of a 200 x 200 Miura)
         self._released = None
-        self.factor = factorize(self._kkt_matrix(upper=True), upper=True, **schur)
+        kkt = self._kkt_matrix(upper=True)
+        release_free_heap(self.n_dof)  # the factorisation allocates through MKL
+        self.factor = factorize(kkt, upper=True, **schur)
+        del kkt
         self.timer.factorize += time.perf_counter() - t_start
         self.timer.n_factorizations += 1
         perturbed = getattr(self.factor, "perturbed_pivots", None)

@@ -42,3 +42,12 @@ def test_release_free_heap_is_harmless_to_call_repeatedly():
     first = release_free_heap()
     assert release_free_heap() is first
     assert x.sum() == 45.0
+
+
+def test_release_free_heap_skips_small_models():
+    """Below ``LARGE_MODEL_DOF`` DOFs the release is not made (False); from it on, it is
+    made where the C library can."""
+    from barhinge.linalg.heap import LARGE_MODEL_DOF
+
+    assert release_free_heap(LARGE_MODEL_DOF - 1) is False
+    assert release_free_heap(LARGE_MODEL_DOF) is release_free_heap()

@@ -36,3 +36,18 @@ def test_pattern_positions_of_every_stored_entry_and_of_none() -> None:
 def test_index_dtype_is_32_bit_up_to_the_scipy_limit() -> None:
     assert index_dtype(2**31 - 1, 5) is np.int32
     assert index_dtype(2**31) is np.int64
+
+
+def test_gather_into_equals_fancy_indexing_across_chunks(monkeypatch) -> None:
+    """The chunked gather writes ``values[index]`` into ``out`` whatever the chunk size,
+    including an index shorter than a chunk and one ending inside a chunk."""
+    from barhinge.linalg import indices
+
+    rng = np.random.default_rng(8)
+    values = rng.standard_normal(1000)
+    index = rng.integers(0, 1000, 2503).astype(np.int32)
+    for chunk in (7, 1000, 4096):
+        monkeypatch.setattr(indices, "GATHER_CHUNK", chunk)
+        out = np.full(len(index), np.nan)
+        assert indices.gather_into(values, index, out) is out
+        np.testing.assert_array_equal(out, values[index])
