@@ -11,8 +11,10 @@ the last axis (what the vectorised kernels write, row by row, through :class:`Pa
 Only the upper triangle (diagonal included) of each symmetric element matrix is written. An
 evaluation sums the instances into the node-pair blocks of the global upper triangle with two
 0/1 summation matrices (one per orientation of the pair: an instance whose first node is the
-larger adds its block transposed), nine sparse products each, and mirrors the sums into the
-full matrix by one gather; the global matrix is exactly symmetric. The summation matrices are
+larger adds its block transposed), nine sparse products each, and fills the full matrix
+from the sums block by block (each block of the full pattern reads its node-pair block as it
+is, transposed, or as a diagonal block: one node-pair index and one code a block, not a
+map per entry); the global matrix is exactly symmetric. The summation matrices are
 kept per chunk of ``ASSEMBLY_CHUNK`` elements, so an evaluation can write and sum one chunk's
 values at a time (:meth:`Assembler.block_sums_filled`) and never hold the whole value array.
 The maps hold one entry per node pair of an element, not per matrix entry: 7 to 8 times
@@ -85,6 +87,12 @@ def _block_pattern(
 
 #: component ``3 j + i`` of a 3x3 block for its component ``3 i + j`` (the transpose)
 _TRANSPOSED = np.array([0, 3, 6, 1, 4, 7, 2, 5, 8])
+
+#: how a block of the full pattern reads its node-pair block's sums (``_block_code``)
+_PLAIN, _TRANSPOSED_BLOCK, _DIAGONAL = 0, 1, 2
+#: blocks of the full pattern filled at a time by :meth:`Assembler.matrix_from_sums`
+#: (its temporaries: a few arrays of this many entries)
+SUMS_ROWS_CHUNK = 1 << 18
 
 
 class _Chunk(NamedTuple):
@@ -255,21 +263,28 @@ class Assembler:
         del swapped, inv, local
         self._n_blocks = nblk
 
-        # 3. full symmetric CSR pattern from the blocks, and the gather from the block sums
+        # 3. full symmetric CSR pattern from the blocks, and what fills it from the block sums:
+        #    every block of the full pattern (row-major) names its node-pair block and whether
+        #    it is read as it is, transposed (the lower triangle's mirror), or as a diagonal
+        #    block (whose lower components are read from the upper ones); no map per entry
         bA, bB = bA.astype(itype), bB.astype(itype)
         offd = bA != bB
         rn = np.concatenate([bA, bB[offd]])
         cn = np.concatenate([bB, bA[offd]])
         bid = np.concatenate([np.arange(nblk, dtype=itype), np.flatnonzero(offd).astype(itype)])
-        tr = np.concatenate([np.zeros(nblk, bool), np.ones(int(offd.sum()), bool)])
+        code = np.concatenate(
+            [np.where(offd, _PLAIN, _DIAGONAL), np.full(int(offd.sum()), _TRANSPOSED_BLOCK)]
+        ).astype(np.int8)
         del bA, bB, offd
         o = np.lexsort((cn, rn))
-        rn, cn, bid, tr = rn[o], cn[o], bid[o], tr[o]
+        rn, cn, bid, code = rn[o], cn[o], bid[o], code[o]
         del o
-        diag = rn == cn
         indptr_n = np.zeros(N + 1, itype)
         np.cumsum(np.bincount(rn, minlength=N), out=indptr_n[1:])
         del rn
+        self._blocks_indptr = indptr_n  # (N + 1,) the full pattern's blocks of each node row
+        self._block_source = bid  # the node-pair block each of them reads
+        self._block_code = code  # read as it is, transposed, or as a diagonal block
         deg = np.diff(indptr_n)
         seg_len = np.repeat(3 * deg, 3)  # dof row (A, i) holds 3 entries per neighbour
         seg_start = np.zeros(n + 1, itype)
@@ -279,20 +294,12 @@ class Assembler:
         del seg_len
         p = np.arange(total, dtype=itype) - seg_start[seg]
         k = np.repeat(indptr_n[:-1], 3)[seg]
-        k += p // 3
-        i = (seg % 3).astype(np.int8)
         del seg
-        j = (p % 3).astype(np.int8)
-        del p
-        lo, hi = np.minimum(i, j), np.maximum(i, j)
-        comp = np.where(diag[k], 3 * lo + hi, np.where(tr[k], 3 * j + i, 3 * i + j))
-        del lo, hi, i
-        # position in the component-major block sums ``(9, n_blocks)``
-        self._gather = comp.astype(itype) * itype(nblk)
-        self._gather += bid[k]
-        del comp
+        k += p // 3
         self.indices = 3 * cn[k]
-        self.indices += j
+        del k
+        self.indices += (p % 3).astype(itype)
+        del p
         self.indptr = seg_start
         self.nnz = total
 
@@ -300,7 +307,8 @@ class Assembler:
     def nbytes(self) -> int:
         """Bytes held by the scatter maps and the pattern (bytes; the scratch buffer of
         :meth:`value_buffers` excluded)."""
-        arrays = [self._fdofs, self._gather, self.indices, self.indptr, self._ones]
+        arrays = [self._fdofs, self.indices, self.indptr, self._ones]
+        arrays += [self._blocks_indptr, self._block_source, self._block_code]
         for chunk in (c for group in self._chunks for c in group):
             for S in (chunk.direct, chunk.swapped):
                 arrays += [S.indices, S.indptr]  # their data: views of self._ones
@@ -407,11 +415,38 @@ class Assembler:
 
     def matrix_from_sums(self, sums: np.ndarray) -> sp.csr_matrix:
         """(n_dof, n_dof) CSR matrix of the block sums of :meth:`block_sums` (its values
-        gathered from them; the pattern's arrays shared)."""
-        K = sp.csr_matrix(
-            (sums.ravel()[self._gather], self.indices, self.indptr),
-            shape=(self.n_dof, self.n_dof),
-        )
+        filled from them, node rows ``SUMS_ROWS_CHUNK`` blocks at a time; the pattern's
+        arrays shared)."""
+        data = np.empty(self.nnz)
+        ip = self._blocks_indptr
+        N = self.n_nodes
+        a0 = 0
+        while a0 < N:
+            # node rows [a0, a1) holding about SUMS_ROWS_CHUNK blocks (at least one row)
+            a1 = int(np.searchsorted(ip, ip[a0] + SUMS_ROWS_CHUNK, side="right")) - 1
+            a1 = min(max(a1, a0 + 1), N)
+            k0, k1 = int(ip[a0]), int(ip[a1])
+            deg = np.diff(ip[a0 : a1 + 1]).astype(np.int64)
+            row = np.repeat(np.arange(a1 - a0), deg)
+            # position of entry (0, 0) of each block; a row of 3 x 3 blocks spans 3 deg
+            at = 6 * ip[a0:a1].astype(np.int64)[row] + 3 * np.arange(k0, k1, dtype=np.int64)
+            step = 3 * deg[row]
+            del row
+            src = self._block_source[k0:k1]
+            code = self._block_code[k0:k1]
+            transposed, not_plain = code == _TRANSPOSED_BLOCK, code != _PLAIN
+            row_at = [at, at + step, at + 2 * step]  # entry (i, 0) of each block
+            del at, step
+            for i in range(3):
+                data[row_at[i] + i] = sums[4 * i][src]
+                for j in range(i + 1, 3):
+                    upper, lower = sums[3 * i + j][src], sums[3 * j + i][src]
+                    # (i, j) reads the lower component where transposed; (j, i) the upper
+                    # one where transposed or on a diagonal block
+                    data[row_at[i] + j] = np.where(transposed, lower, upper)
+                    data[row_at[j] + i] = np.where(not_plain, upper, lower)
+            a0 = a1
+        K = sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n_dof, self.n_dof))
         K.has_sorted_indices = True
         return K
 

@@ -438,3 +438,28 @@ def test_value_buffer_above_the_kept_size_is_new_at_every_evaluation(
     assert np.abs(ref).max() > 0
     for K in tangents[1:]:
         assert np.array_equal(K.toarray(), ref)
+
+
+@pytest.mark.parametrize("rows_chunk", [1, 5, 1 << 18])
+def test_the_matrix_filled_from_block_sums_in_parts_is_the_dense_sum(
+    rows_chunk: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``matrix_from_sums`` fills the full matrix node row by node row, about
+    ``SUMS_ROWS_CHUNK`` blocks at a time (here: one block, a few, everything), each block of
+    the full pattern reading its node-pair block as it is, transposed (the mirror of an
+    upper block) or as a diagonal block: the dense sum of the element matrices, symmetric,
+    with random nodes (blocks of both orientations) and along a strip."""
+    import barhinge.assembly as assembly
+    from barhinge.assembly import Assembler
+
+    monkeypatch.setattr(assembly, "SUMS_ROWS_CHUNK", rows_chunk)
+    rng = np.random.default_rng(11)
+    n_nodes = 30
+    scattered = [rng.permuted(np.tile(np.arange(n_nodes), (25, 1)), axis=1)[:, :k] for k in (2, 4)]
+    strip = [np.arange(k)[None, :] + np.arange(n_nodes - 4)[:, None] for k in (2, 4)]
+    for groups in (scattered, strip):
+        asm = Assembler(n_nodes, groups)
+        dense, packed = _random_element_matrices(groups, n_nodes, rng)
+        K = asm.matrix_packed(packed).toarray()
+        np.testing.assert_allclose(K, dense, rtol=0, atol=1e-12 * np.abs(dense).max())
+        assert np.array_equal(K, K.T)
