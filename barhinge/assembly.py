@@ -11,10 +11,9 @@ the last axis (what the vectorised kernels write, row by row, through :class:`Pa
 Only the upper triangle (diagonal included) of each symmetric element matrix is written. An
 evaluation sums the instances into the node-pair blocks of the global upper triangle with two
 0/1 summation matrices (one per orientation of the pair: an instance whose first node is the
-larger adds its block transposed), nine sparse products each, and fills the full matrix
-from the sums block by block (each block of the full pattern reads its node-pair block as it
-is, transposed, or as a diagonal block: one node-pair index and one code a block, not a
-map per entry); the global matrix is exactly symmetric. The summation matrices are
+larger adds its block transposed), nine sparse products each, and gathers the full matrix's
+values from the sums into the buffer the sums were made in (they are never held beside
+them); the global matrix is exactly symmetric. The summation matrices are
 kept per chunk of ``ASSEMBLY_CHUNK`` elements, so an evaluation can write and sum one chunk's
 values at a time (:meth:`Assembler.block_sums_filled`) and never hold the whole value array.
 The maps hold one entry per node pair of an element, not per matrix entry: 7 to 8 times
@@ -43,10 +42,10 @@ ENTRY_STRUCTURES = 2
 KEEP_SCRATCH_BYTES = 256 * 2**20
 #: elements per chunk of the summation into node-pair blocks: an evaluation that writes its
 #: values chunk by chunk (:meth:`Assembler.block_sums_filled`) holds one chunk's values
-#: (9 x node pairs x chunk floats: 12 MB for the hinges) where the whole array is 0.9 GB at
-#: 1 M DOF. Smaller chunks measured as fast (Miura 100 x 100: 0.37 s an evaluation against
-#: 0.50 s with 65536, whose chunk held 47 MB more) and keep the summation maps as small
-ASSEMBLY_CHUNK = 16384
+#: (9 x node pairs x chunk floats: 47 MB for the hinges) where the whole array is 0.9 GB at
+#: 1 M DOF. (16384 held 35 MB less and was ~10 % slower an evaluation at 70 x 70; the peak
+#: of a large assembly is where its sums and the tangent's values are held together.)
+ASSEMBLY_CHUNK = 65536
 
 
 def element_dofs(conn: np.ndarray) -> np.ndarray:
@@ -88,11 +87,10 @@ def _block_pattern(
 #: component ``3 j + i`` of a 3x3 block for its component ``3 i + j`` (the transpose)
 _TRANSPOSED = np.array([0, 3, 6, 1, 4, 7, 2, 5, 8])
 
-#: how a block of the full pattern reads its node-pair block's sums (``_block_code``)
-_PLAIN, _TRANSPOSED_BLOCK, _DIAGONAL = 0, 1, 2
-#: blocks of the full pattern filled at a time by :meth:`Assembler.matrix_from_sums`
-#: (its temporaries: a few arrays of this many entries)
-SUMS_ROWS_CHUNK = 1 << 18
+#: element-vector entries summed at a time by :meth:`Assembler.force`
+FORCE_CHUNK = 1 << 20
+#: tangent entries filled at a time by :meth:`Assembler.matrix_from_sums` (whole node rows)
+SUMS_FILL_CHUNK = 1 << 20
 
 
 class _Chunk(NamedTuple):
@@ -263,28 +261,23 @@ class Assembler:
         del swapped, inv, local
         self._n_blocks = nblk
 
-        # 3. full symmetric CSR pattern from the blocks, and what fills it from the block sums:
-        #    every block of the full pattern (row-major) names its node-pair block and whether
-        #    it is read as it is, transposed (the lower triangle's mirror), or as a diagonal
-        #    block (whose lower components are read from the upper ones); no map per entry
+        # 3. full symmetric CSR pattern from the blocks, and the gather from the block sums
+        #    (block-major: block b's component c at 9 b + c)
         bA, bB = bA.astype(itype), bB.astype(itype)
         offd = bA != bB
         rn = np.concatenate([bA, bB[offd]])
         cn = np.concatenate([bB, bA[offd]])
         bid = np.concatenate([np.arange(nblk, dtype=itype), np.flatnonzero(offd).astype(itype)])
-        code = np.concatenate(
-            [np.where(offd, _PLAIN, _DIAGONAL), np.full(int(offd.sum()), _TRANSPOSED_BLOCK)]
-        ).astype(np.int8)
+        tr = np.concatenate([np.zeros(nblk, bool), np.ones(int(offd.sum()), bool)])
         del bA, bB, offd
         o = np.lexsort((cn, rn))
-        rn, cn, bid, code = rn[o], cn[o], bid[o], code[o]
+        rn, cn, bid, tr = rn[o], cn[o], bid[o], tr[o]
         del o
+        diag = rn == cn
         indptr_n = np.zeros(N + 1, itype)
         np.cumsum(np.bincount(rn, minlength=N), out=indptr_n[1:])
         del rn
         self._blocks_indptr = indptr_n  # (N + 1,) the full pattern's blocks of each node row
-        self._block_source = bid  # the node-pair block each of them reads
-        self._block_code = code  # read as it is, transposed, or as a diagonal block
         deg = np.diff(indptr_n)
         seg_len = np.repeat(3 * deg, 3)  # dof row (A, i) holds 3 entries per neighbour
         seg_start = np.zeros(n + 1, itype)
@@ -294,12 +287,19 @@ class Assembler:
         del seg_len
         p = np.arange(total, dtype=itype) - seg_start[seg]
         k = np.repeat(indptr_n[:-1], 3)[seg]
-        del seg
         k += p // 3
-        self.indices = 3 * cn[k]
-        del k
-        self.indices += (p % 3).astype(itype)
+        i = (seg % 3).astype(np.int8)
+        del seg
+        j = (p % 3).astype(np.int8)
         del p
+        lo, hi = np.minimum(i, j), np.maximum(i, j)
+        comp = np.where(diag[k], 3 * lo + hi, np.where(tr[k], 3 * j + i, 3 * i + j))
+        del lo, hi, i
+        self._gather = bid[k] * itype(9)
+        self._gather += comp.astype(itype)
+        del comp
+        self.indices = 3 * cn[k]
+        self.indices += j
         self.indptr = seg_start
         self.nnz = total
 
@@ -307,8 +307,8 @@ class Assembler:
     def nbytes(self) -> int:
         """Bytes held by the scatter maps and the pattern (bytes; the scratch buffer of
         :meth:`value_buffers` excluded)."""
-        arrays = [self._fdofs, self.indices, self.indptr, self._ones]
-        arrays += [self._blocks_indptr, self._block_source, self._block_code]
+        arrays = [self._fdofs, self._gather, self.indices, self.indptr, self._ones]
+        arrays.append(self._blocks_indptr)
         for chunk in (c for group in self._chunks for c in group):
             for S in (chunk.direct, chunk.swapped):
                 arrays += [S.indices, S.indptr]  # their data: views of self._ones
@@ -325,16 +325,24 @@ class Assembler:
     def force(self, element_vectors: list[np.ndarray]) -> np.ndarray:
         """(n_dof,) sum of entry-major element vectors ``(3 * nodes, n_el)`` of each group
         (the first groups, in order: groups left out contribute nothing), group by group
-        (no concatenated copy of the element vectors)."""
+        and ``FORCE_CHUNK`` entries at a time (no concatenated copy of the element vectors,
+        no 64-bit copy of the whole map: ``numpy.bincount`` made one, 92 MB for the hinges
+        of a 200 x 200 Miura; ``numpy.add.at`` in chunks measured as fast)."""
         out = np.zeros(self.n_dof)
         start = 0
         for f in element_vectors:
             val = f.ravel()
-            out += np.bincount(
-                self._fdofs[start : start + len(val)], weights=val, minlength=self.n_dof
-            )
+            for s in range(0, len(val), FORCE_CHUNK):
+                e = min(s + FORCE_CHUNK, len(val))
+                np.add.at(out, self._fdofs[start + s : start + e], val[s:e])
             start += len(val)
         return out
+
+    def add_force(self, out: np.ndarray, group: int, sl: slice, values: np.ndarray) -> None:
+        """Add the entry-major element vectors ``values`` ``(3 * nodes, n)`` of the elements
+        ``sl`` of ``group`` into the ``(n_dof,)`` vector ``out`` (an evaluation sums its
+        force chunk by chunk, as it writes the element matrices)."""
+        np.add.at(out, self.dofs[group][sl].T.ravel(), values.ravel())
 
     def _group_views(self, flat: np.ndarray) -> list[PackedRows]:
         """The packed rows of every group in the block-layout array ``flat``."""
@@ -385,7 +393,7 @@ class Assembler:
         Between the two the caller can drop the value array (about 0.9 GB at 1 M DOF), so
         that it is not held beside the matrix's values."""
         V = flat.reshape(9, self.n_instances)
-        sums = np.zeros((9, self._n_blocks))
+        sums = self._new_sums()
         for (off, npair, ne, _, _), chunks in zip(self._layout, self._chunks, strict=True):
             Vg = V[:, off : off + npair * ne].reshape(9, npair, ne)
             for chunk in chunks:  # a copy of the chunk's values where it is not the group
@@ -399,7 +407,7 @@ class Assembler:
         :class:`PackedRows` of a scratch buffer of those elements only, and must write every
         packed row. At most ``ASSEMBLY_CHUNK`` elements' values exist at a time (the whole
         array would be about 0.9 GB at 1 M DOF, beside a held factorisation)."""
-        sums = np.zeros((9, self._n_blocks))
+        sums = self._new_sums()
         groups = zip(self._layout, self._chunks, strict=True)
         for g, ((_, npair, ne, comp, pair), chunks) in enumerate(groups):
             full = min(ne, ASSEMBLY_CHUNK)
@@ -413,39 +421,51 @@ class Assembler:
                 _add_chunk(sums, buf.reshape(9, -1), chunk)
         return sums
 
+    def _new_sums(self) -> np.ndarray:
+        """Zeroed ``(9, n_blocks)`` block sums, block-major in memory (a transposed view),
+        at the start of a buffer of the tangent's ``nnz`` values: :meth:`matrix_from_sums`
+        fills the tangent's values into that same buffer, so the sums and the values are
+        never held side by side (140 MB and 242 MB at 200 x 200)."""
+        nblk = self._n_blocks
+        return np.zeros(self.nnz)[: 9 * nblk].reshape(nblk, 9).T
+
+    def _values_buffer(self, sums: np.ndarray) -> np.ndarray | None:
+        """The ``nnz`` buffer ``sums`` of :meth:`_new_sums` lies at the start of, else None."""
+        base = sums
+        while base.base is not None:
+            base = base.base
+        nblk = self._n_blocks
+        fits = base.ndim == 1 and len(base) == self.nnz and base.dtype == np.float64
+        laid = sums.shape == (9, nblk) and sums.strides == (8, 72)
+        if fits and laid and sums.ctypes.data == base.ctypes.data:
+            return base
+        return None
+
     def matrix_from_sums(self, sums: np.ndarray) -> sp.csr_matrix:
-        """(n_dof, n_dof) CSR matrix of the block sums of :meth:`block_sums` (its values
-        filled from them, node rows ``SUMS_ROWS_CHUNK`` blocks at a time; the pattern's
-        arrays shared)."""
-        data = np.empty(self.nnz)
+        """(n_dof, n_dof) CSR matrix of the block sums of :meth:`block_sums` (its pattern's
+        arrays shared).
+
+        Its values are gathered from the sums whole node rows at a time (about
+        ``SUMS_FILL_CHUNK`` entries), from the last rows to the first, into the buffer the
+        sums of :meth:`block_sums` lie at the start of (other sums are copied into a new one
+        first): node row A's values start at or after the sums of every node-pair block the
+        rows before it read, so a chunk of rows only overwrites sums no earlier row reads
+        (``sums`` is then consumed)."""
+        data = self._values_buffer(sums)
+        nblk = self._n_blocks
+        if data is None:
+            data = np.empty(self.nnz)
+            data[: 9 * nblk].reshape(nblk, 9)[...] = sums.T
+        flat = data[: 9 * nblk]
         ip = self._blocks_indptr
-        N = self.n_nodes
-        a0 = 0
-        while a0 < N:
-            # node rows [a0, a1) holding about SUMS_ROWS_CHUNK blocks (at least one row)
-            a1 = int(np.searchsorted(ip, ip[a0] + SUMS_ROWS_CHUNK, side="right")) - 1
-            a1 = min(max(a1, a0 + 1), N)
-            k0, k1 = int(ip[a0]), int(ip[a1])
-            deg = np.diff(ip[a0 : a1 + 1]).astype(np.int64)
-            row = np.repeat(np.arange(a1 - a0), deg)
-            # position of entry (0, 0) of each block; a row of 3 x 3 blocks spans 3 deg
-            at = 6 * ip[a0:a1].astype(np.int64)[row] + 3 * np.arange(k0, k1, dtype=np.int64)
-            step = 3 * deg[row]
-            del row
-            src = self._block_source[k0:k1]
-            code = self._block_code[k0:k1]
-            transposed, not_plain = code == _TRANSPOSED_BLOCK, code != _PLAIN
-            row_at = [at, at + step, at + 2 * step]  # entry (i, 0) of each block
-            del at, step
-            for i in range(3):
-                data[row_at[i] + i] = sums[4 * i][src]
-                for j in range(i + 1, 3):
-                    upper, lower = sums[3 * i + j][src], sums[3 * j + i][src]
-                    # (i, j) reads the lower component where transposed; (j, i) the upper
-                    # one where transposed or on a diagonal block
-                    data[row_at[i] + j] = np.where(transposed, lower, upper)
-                    data[row_at[j] + i] = np.where(not_plain, upper, lower)
-            a0 = a1
+        a1 = self.n_nodes
+        while a1 > 0:
+            # node rows [a0, a1): their entries [9 ip[a0], 9 ip[a1])
+            a0 = int(np.searchsorted(ip, ip[a1] - SUMS_FILL_CHUNK // 9, side="left"))
+            a0 = max(min(a0, a1 - 1), 0)
+            p0, p1 = 9 * int(ip[a0]), 9 * int(ip[a1])
+            data[p0:p1] = flat[self._gather[p0:p1]]  # read (a copy) before the write
+            a1 = a0
         K = sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n_dof, self.n_dof))
         K.has_sorted_indices = True
         return K

@@ -566,16 +566,20 @@ class BarHingeModel:
         law = self._hinge_law
         if len(self.hinge_pairs):
             law = functools.partial(law, pair_moment=self._pair_moment(hinge_angle(X, hinges)))
-        K = force = None
+        K = None
         if tangent:
             nh = len(hinges)
             rho, M, Kt, Wh = (np.empty(nh) for _ in range(4))
-            g = np.empty((12, nh))
+            # the hinge gradients (12 floats a hinge) are kept only for the couplings'
+            # tangent; the force is summed chunk by chunk as the element values are written
+            g = np.empty((12, nh)) if len(self.hinge_pairs) else None
+            force = np.zeros(self.n_dof)
             XT = np.ascontiguousarray(X.T)
             L0, strain = self.bar_L0, self.strain
 
             def fill(group: int, sl: slice, rows: PackedRows) -> None:
-                """The packed upper triangles of the elements ``sl`` of a group."""
+                """The packed upper triangles of the elements ``sl`` of a group, and their
+                internal force added to ``force``."""
                 if group == 0:
                     # bar: [[k, -k], [-k, k]] with k = S'' d d^T + S B, packed upper
                     # triangle of 6x6; the 6 distinct entries of the symmetric 3x3 k. B and
@@ -589,31 +593,30 @@ class BarHingeModel:
                     for p_, (q, sgn) in enumerate(zip(_BAR_Q, _BAR_SIGN, strict=True)):
                         if p_ != _BAR_FIRST[q]:
                             np.multiply(rows[_BAR_FIRST[q]], sgn, out=rows[p_])
-                else:  # g (12, nh), packed upper triangle (78, nh) of the hinge Hessian
+                    fb = dT * S[sl]
+                    asm.add_force(force, 0, sl, np.concatenate([-fb, fb]))
+                else:  # packed upper triangle (78, nh) of the hinge Hessian
                     out = hinge_energy_hessian_packed(
                         X, hinges[sl], law, rows, start=sl.start, XT=XT
                     )
-                    rho[sl], M[sl], Kt[sl], Wh[sl], g[:, sl] = out[:5]
+                    rho[sl], M[sl], Kt[sl], Wh[sl], g_sl = out[:5]
+                    if g is not None:
+                        g[:, sl] = g_sl
+                    asm.add_force(force, 1, sl, g_sl * M[sl])
 
             sums = asm.block_sums_filled(fill)  # one chunk of element values at a time
             del XT
-            release_free_heap(self.n_dof)  # the chunks' temporaries, before K's values
-            if not len(self.hinge_pairs):
-                # the force first: the hinge gradients (12 floats a hinge) are not held
-                # beside the tangent's values while they are gathered
-                force = self._element_force(S, d, g, M)
-                del g
-            K = asm.matrix_from_sums(sums)
+            K = asm.matrix_from_sums(sums)  # in the sums' own buffer
             del sums
-            if len(self.hinge_pairs):
+            if g is not None:
                 self._add_pair_tangent(K, g)
             if len(self.bar_pairs):
                 self._add_bar_pair_tangent(K, d)
         else:
             rho, g = hinge_angle_gradient_t(X, hinges)
             M, Kt, Wh = self._hinge_law(rho)
-        if force is None:
-            force = self._element_force(S, d, g, M)
+            fb = (S[:, None] * d).T  # (3, nb)
+            force = asm.force([np.concatenate([-fb, fb], axis=0), np.multiply(g, M, out=g)])
         f = self._is_fold
         return Evaluation(
             energy_bars=float(Wb.sum()),
@@ -626,15 +629,6 @@ class BarHingeModel:
             hinge_angle=rho,
             hinge_moment=M,
         )
-
-    def _element_force(
-        self, S: np.ndarray, d: np.ndarray, g: np.ndarray, M: np.ndarray
-    ) -> np.ndarray:
-        """(n_dof,) internal force of the bars (``dW/d eps`` ``S``, strain derivative ``d``)
-        and hinges (moments ``M``, angle gradients ``g`` (12, n_hinges), overwritten)."""
-        fb = (S[:, None] * d).T  # (3, nb)
-        fe_bar = np.concatenate([-fb, fb], axis=0)
-        return self.assembler.force([fe_bar, np.multiply(g, M, out=g)])
 
     def energy(self, X: np.ndarray) -> float:
         """Total stored energy at ``X``."""

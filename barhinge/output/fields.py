@@ -101,7 +101,8 @@ def _model_topology(model: Any) -> dict[str, np.ndarray]:
     at = np.minimum(np.searchsorted(key_line[order], key_h), len(order) - 1)
     ok = key_line[order[at]] == key_h
     on_edge = np.isin(key_line, _pair_index(model.pattern.edges, n))
-    topo = {"tri": tri, "wing_tri": wing_tri, "lines": lines, "fold": fold,
+    topo = {"tri": tri, "wing_tri": wing_tri, "tri_face": _triangle_faces(model, tri),
+            "lines": lines, "fold": fold,
             "line_of_fold": order[at[ok]], "fold_hinge": hf[ok], "on_edge": on_edge,
             "boundary": boundary_nodes(tri, n)}  # fmt: skip
     _TOPOLOGY[model] = topo
@@ -127,22 +128,30 @@ def _pattern_topology(cp: Any, n: int) -> dict[str, np.ndarray]:
     return topo
 
 
-def _triangle_membrane(model: Any, X: np.ndarray, tri: np.ndarray) -> np.ndarray:
-    """(n_tri, 9) membrane stress resultant tensor ``N`` (global axes, row-major 3 x 3,
-    force per length) of the panel each triangle lies in
-    (:func:`barhinge.analysis.forces.panel_membrane_resultants`)."""
+def _triangle_faces(model: Any, tri: np.ndarray) -> np.ndarray:
+    """(n_tri,) the face of the model's pattern each triangle ``tri`` lies in (-1 where a
+    triangle is not one of the model's triangulation)."""
     from barhinge.model.triangulate import triangulate
 
-    _, Ng = panel_membrane_resultants(model, X)
     t = triangulate(model.pattern, model.scheme)
-    n = len(X)
+    n = model.n_nodes
     key = lambda T: np.sort(np.asarray(T, np.int64), axis=1) @ np.array([n * n, n, 1])  # noqa: E731
     k_model, k_tri = key(t.triangles), key(tri)
     order = np.argsort(k_model)
     at = np.minimum(np.searchsorted(k_model[order], k_tri), len(order) - 1)
     found = k_model[order[at]] == k_tri
-    out = np.full((len(tri), 9), np.nan)
-    out[found] = Ng[t.tri_face[order[at[found]]]].reshape(-1, 9)
+    return np.where(found, np.asarray(t.tri_face)[order[at]], -1)
+
+
+def _triangle_membrane(model: Any, X: np.ndarray, tri_face: np.ndarray) -> np.ndarray:
+    """(n_tri, 9) membrane stress resultant tensor ``N`` (global axes, row-major 3 x 3,
+    force per length) of the panel each triangle lies in (its face ``tri_face``, from
+    :func:`_triangle_faces`; NaN where -1)
+    (:func:`barhinge.analysis.forces.panel_membrane_resultants`)."""
+    _, Ng = panel_membrane_resultants(model, X)
+    out = np.full((len(tri_face), 9), np.nan)
+    found = tri_face >= 0
+    out[found] = Ng[tri_face[found]].reshape(-1, 9)
     return out
 
 
@@ -241,7 +250,7 @@ def state_data(
         strain_line = eps
         kind_line = np.where(is_crease, 2, np.where(topo["on_edge"], 3, 1))
         forces: tuple[np.ndarray, np.ndarray] | None = (bar_force, moment_line)
-        membrane = _triangle_membrane(model, X, tri)
+        membrane = _triangle_membrane(model, X, topo["tri_face"])
         Xr = model.X0 if X_ref is None else X_ref
     else:
         cp = pattern

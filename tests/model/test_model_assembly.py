@@ -440,19 +440,20 @@ def test_value_buffer_above_the_kept_size_is_new_at_every_evaluation(
         assert np.array_equal(K.toarray(), ref)
 
 
-@pytest.mark.parametrize("rows_chunk", [1, 5, 1 << 18])
+@pytest.mark.parametrize("fill_chunk", [1, 90, 1 << 20])
 def test_the_matrix_filled_from_block_sums_in_parts_is_the_dense_sum(
-    rows_chunk: int, monkeypatch: pytest.MonkeyPatch
+    fill_chunk: int, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """``matrix_from_sums`` fills the full matrix node row by node row, about
-    ``SUMS_ROWS_CHUNK`` blocks at a time (here: one block, a few, everything), each block of
-    the full pattern reading its node-pair block as it is, transposed (the mirror of an
-    upper block) or as a diagonal block: the dense sum of the element matrices, symmetric,
-    with random nodes (blocks of both orientations) and along a strip."""
+    """``matrix_from_sums`` gathers the matrix's values into the buffer its sums lie at the
+    start of, whole node rows at a time, from the last rows to the first (``SUMS_FILL_CHUNK``
+    entries: one row at a time, a few rows, everything): the dense sum of the element
+    matrices, symmetric, with random nodes (blocks of both orientations) and along a strip;
+    sums not made by the assembler (a copy here) give the same matrix and are left as they
+    were."""
     import barhinge.assembly as assembly
     from barhinge.assembly import Assembler
 
-    monkeypatch.setattr(assembly, "SUMS_ROWS_CHUNK", rows_chunk)
+    monkeypatch.setattr(assembly, "SUMS_FILL_CHUNK", fill_chunk)
     rng = np.random.default_rng(11)
     n_nodes = 30
     scattered = [rng.permuted(np.tile(np.arange(n_nodes), (25, 1)), axis=1)[:, :k] for k in (2, 4)]
@@ -460,6 +461,15 @@ def test_the_matrix_filled_from_block_sums_in_parts_is_the_dense_sum(
     for groups in (scattered, strip):
         asm = Assembler(n_nodes, groups)
         dense, packed = _random_element_matrices(groups, n_nodes, rng)
-        K = asm.matrix_packed(packed).toarray()
-        np.testing.assert_allclose(K, dense, rtol=0, atol=1e-12 * np.abs(dense).max())
-        assert np.array_equal(K, K.T)
+        flat = np.zeros(9 * asm.n_instances)
+        for view, arr in zip(asm._group_views(flat), packed, strict=True):
+            view.buf[view.comp, view.pair] = arr
+        sums = asm.block_sums(flat)
+        own = np.array(sums)  # a plain (9, n_blocks) array: not the assembler's buffer
+        K = asm.matrix_from_sums(sums)
+        assert np.shares_memory(K.data, sums)  # filled in place of its sums
+        np.testing.assert_allclose(K.toarray(), dense, rtol=0, atol=1e-12 * np.abs(dense).max())
+        assert np.array_equal(K.toarray(), K.toarray().T)
+        kept = own.copy()
+        K2 = asm.matrix_from_sums(own)
+        assert np.array_equal(K2.data, K.data) and np.array_equal(own, kept)
