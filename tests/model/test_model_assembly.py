@@ -321,6 +321,19 @@ def test_hinge_couplings_keep_the_scatter_maps_small() -> None:
     assert b.nbytes <= a.nbytes + 12 * (b.nnz - a.nnz)
 
 
+def _scattered_and_strip(
+    n_nodes: int, n_el: int, rng: np.random.Generator
+) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """Two sets of element groups (bars of 2 nodes, hinges of 4) on ``n_nodes`` nodes:
+    ``n_el`` elements each on random nodes (their blocks of both orientations, addressed by
+    index), and elements along a strip (blocks in a range)."""
+    scattered = [
+        rng.permuted(np.tile(np.arange(n_nodes), (n_el, 1)), axis=1)[:, :k] for k in (2, 4)
+    ]
+    strip = [np.arange(k)[None, :] + np.arange(n_nodes - 4)[:, None] for k in (2, 4)]
+    return scattered, strip
+
+
 def _random_element_matrices(
     groups: list[np.ndarray], n_nodes: int, rng: np.random.Generator
 ) -> tuple[np.ndarray, list[np.ndarray]]:
@@ -386,8 +399,7 @@ def test_element_values_written_chunk_by_chunk_sum_to_the_dense_sum(
     monkeypatch.setattr(assembly, "ASSEMBLY_CHUNK", chunk)
     rng = np.random.default_rng(5)
     n_nodes = 40
-    scattered = [rng.permuted(np.tile(np.arange(n_nodes), (30, 1)), axis=1)[:, :k] for k in (2, 4)]
-    strip = [np.arange(k)[None, :] + np.arange(n_nodes - 4)[:, None] for k in (2, 4)]
+    scattered, strip = _scattered_and_strip(n_nodes, 30, rng)
     for groups in (scattered, strip):
         asm = Assembler(n_nodes, groups)
         kinds = {isinstance(c.out, slice) for group in asm._chunks for c in group}
@@ -456,9 +468,7 @@ def test_the_matrix_filled_from_block_sums_in_parts_is_the_dense_sum(
     monkeypatch.setattr(assembly, "SUMS_FILL_CHUNK", fill_chunk)
     rng = np.random.default_rng(11)
     n_nodes = 30
-    scattered = [rng.permuted(np.tile(np.arange(n_nodes), (25, 1)), axis=1)[:, :k] for k in (2, 4)]
-    strip = [np.arange(k)[None, :] + np.arange(n_nodes - 4)[:, None] for k in (2, 4)]
-    for groups in (scattered, strip):
+    for groups in _scattered_and_strip(n_nodes, 25, rng):
         asm = Assembler(n_nodes, groups)
         dense, packed = _random_element_matrices(groups, n_nodes, rng)
         flat = np.zeros(9 * asm.n_instances)
