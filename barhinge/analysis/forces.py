@@ -140,19 +140,34 @@ def _face_bars(model: Any) -> tuple[np.ndarray, np.ndarray]:
     return out
 
 
-def panel_membrane_resultants(model: Any, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Membrane stress resultants of every panel (face) at ``X`` (module docstring).
+@dataclasses.dataclass(frozen=True)
+class _MembraneFit:
+    """What the membrane fit of a model's panels needs that no state changes: the bar rows
+    of each face (ends ``ends``, reference lengths ``L0``, face ``face``), the rows ``A`` of
+    ``eps_b = A . (E_xx, E_yy, E_xy)``, the normal matrices ``AtA`` (n_faces, 3, 3) and
+    the reference panel frames ``e1``, ``e2`` (n_faces, 3)."""
 
-    Returns
-    -------
-    N : (n_faces, 3) float
-        ``N_xx, N_yy, N_xy`` in the panel frame at the reference state (force per length).
-    N_global : (n_faces, 3, 3) float
-        ``N_ab e_a (x) e_b`` in global axes.
-    """
+    ends: np.ndarray
+    L0: np.ndarray
+    face: np.ndarray
+    A: np.ndarray
+    AtA: np.ndarray
+    e1: np.ndarray
+    e2: np.ndarray
+
+
+_MEMBRANE_FIT: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _membrane_fit(model: Any) -> _MembraneFit:
+    """The state-independent part of :func:`panel_membrane_resultants` (cached per model;
+    models are frozen). Raises ConfigError for a face whose bars fix no membrane strain."""
+    try:
+        return _MEMBRANE_FIT[model]
+    except (KeyError, TypeError):
+        pass
     cp = model.pattern
     X0 = np.asarray(model.X0, float)
-    X = np.asarray(X, float)
     bars, faces = _face_bars(model)
     nf = cp.n_faces
     fids = np.arange(nf)
@@ -163,27 +178,49 @@ def panel_membrane_resultants(model: Any, X: np.ndarray) -> tuple[np.ndarray, np
         sel = np.flatnonzero(sizes == k)
         a, b, _ = face_frames(X0, cp.faces, fids[sel])
         e1[sel], e2[sel] = a, b
-    b = model.bars[bars]
-    dx0 = X0[b[:, 1]] - X0[b[:, 0]]
+    ends = np.asarray(model.bars, np.int64)[bars]
+    dx0 = X0[ends[:, 1]] - X0[ends[:, 0]]
     L0 = np.linalg.norm(dx0, axis=1)
     e = dx0 / L0[:, None]
-    dx = X[b[:, 1]] - X[b[:, 0]]
-    eps = 0.5 * (np.einsum("ni,ni->n", dx, dx) / L0**2 - 1.0)  # Green strain of each row
     c1 = np.einsum("ni,ni->n", e, e1[faces])
     c2 = np.einsum("ni,ni->n", e, e2[faces])
     A = np.column_stack([c1 * c1, c2 * c2, 2.0 * c1 * c2])  # eps_b = A . (Exx, Eyy, Exy)
-    # normal equations per face, vectorised: (nf, 3, 3) and (nf, 3)
     AtA = np.zeros((nf, 3, 3))
-    Atb = np.zeros((nf, 3))
     np.add.at(AtA, faces, A[:, :, None] * A[:, None, :])
-    np.add.at(Atb, faces, A * eps[:, None])
     rank = np.linalg.matrix_rank(AtA)
     if (rank < 3).any():
         raise ConfigError(
             f"face {int(np.flatnonzero(rank < 3)[0])} has fewer than three independent bar "
             "directions: its membrane strain is undetermined"
         )
-    E = np.linalg.solve(AtA, Atb[:, :, None])[:, :, 0]  # Exx, Eyy, Exy (tensor shear)
+    fit = _MembraneFit(ends=ends, L0=L0, face=faces, A=A, AtA=AtA, e1=e1, e2=e2)
+    try:
+        _MEMBRANE_FIT[model] = fit
+    except TypeError:  # not weak-referenceable: no cache
+        pass
+    return fit
+
+
+def panel_membrane_resultants(model: Any, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Membrane stress resultants of every panel (face) at ``X`` (module docstring).
+
+    Returns
+    -------
+    N : (n_faces, 3) float
+        ``N_xx, N_yy, N_xy`` in the panel frame at the reference state (force per length).
+    N_global : (n_faces, 3, 3) float
+        ``N_ab e_a (x) e_b`` in global axes.
+    """
+    fit = _membrane_fit(model)
+    X = np.asarray(X, float)
+    nf = len(fit.AtA)
+    dx = X[fit.ends[:, 1]] - X[fit.ends[:, 0]]
+    eps = 0.5 * (np.einsum("ni,ni->n", dx, dx) / fit.L0**2 - 1.0)  # Green strain of each row
+    # normal equations per face, vectorised: (nf, 3)
+    Atb = np.column_stack(
+        [np.bincount(fit.face, fit.A[:, j] * eps, minlength=nf) for j in range(3)]
+    )
+    E = np.linalg.solve(fit.AtA, Atb[:, :, None])[:, :, 0]  # Exx, Eyy, Exy (tensor shear)
     mat = model.material
     C = (
         mat.E
@@ -191,6 +228,7 @@ def panel_membrane_resultants(model: Any, X: np.ndarray) -> tuple[np.ndarray, np
         * np.array([[1.0, mat.nu, 0.0], [mat.nu, 1.0, 0.0], [0.0, 0.0, 1.0 - mat.nu]])
     )
     N = mat.t * (E @ C.T)  # third row of C times Exy gives (1 - nu) Exy = gamma (1-nu)/2
+    e1, e2 = fit.e1, fit.e2
     Ng = (
         N[:, 0, None, None] * e1[:, :, None] * e1[:, None, :]
         + N[:, 1, None, None] * e2[:, :, None] * e2[:, None, :]

@@ -252,6 +252,22 @@ class Modes:
     n_free: int
 
 
+def _lowest_eigenpairs(Kff: sp.csc_matrix, k: int, sigma: float) -> tuple[np.ndarray, np.ndarray]:
+    """The ``k`` eigenpairs of the symmetric ``Kff`` nearest ``sigma`` (shift-invert Lanczos,
+    ``scipy.sparse.linalg.eigsh``), with ``Kff - sigma I`` factorised by the solver's own
+    backend (PARDISO where installed, else SuperLU, as in the Newton solve); ``sigma`` just
+    below zero keeps rigid-body and mechanism modes from making it singular. eigsh's own
+    shift-invert factorises with SuperLU: 2.0 s of factorisation and 2.9 s of solves on the
+    tangent of a folded 40 x 40 Miura sheet."""
+    shifted = UpperSymmetric.from_full(
+        (Kff - sigma * sp.identity(Kff.shape[0], format="csc")).tocsr()
+    )
+    with sparse_solves():
+        lu = factorize_symmetric(get_backend("auto"), shifted)
+        inverse = spla.LinearOperator(Kff.shape, matvec=lu.solve, dtype=float)
+        return spla.eigsh(Kff, k=k, sigma=sigma, which="LM", OPinv=inverse)
+
+
 def stiffness_modes(
     model: Any,
     X: np.ndarray | None = None,
@@ -285,8 +301,7 @@ def stiffness_modes(
         w, V = np.linalg.eigh(Kff.toarray())
         w, V = w[:k], V[:, :k]
     else:
-        # shift below zero: rigid-body / mechanism modes keep K - sigma I non-singular
-        w, V = spla.eigsh(Kff, k=k, sigma=-1e-6 * scale, which="LM")
+        w, V = _lowest_eigenpairs(Kff, k, sigma=-1e-6 * scale)
         order = np.argsort(w)
         w, V = w[order], V[:, order]
     shapes = np.zeros((k, 3 * n))

@@ -39,6 +39,7 @@ from barhinge.errors import ConfigError
 
 __all__ = [
     "dense_calls",
+    "file_threads",
     "free_cores",
     "policy",
     "single_threaded_dense",
@@ -71,6 +72,17 @@ def cores() -> int:
         return len(os.sched_getaffinity(0))
     except AttributeError:  # not on Linux
         return os.cpu_count() or 1
+
+
+def file_threads() -> int:
+    """Threads that write result files side by side: the count of ``BARHINGE_THREADS`` when
+    it is a number, one under ``off``, else the process's cores (zlib compression, most of
+    a field file's time, releases the GIL; the load a finished solve left on the load
+    average is no reason to write one file at a time)."""
+    p = policy()
+    if isinstance(p, int):
+        return p
+    return 1 if p == "off" else cores()
 
 
 def free_cores() -> int:

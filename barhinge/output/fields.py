@@ -16,7 +16,8 @@ from __future__ import annotations
 import contextlib
 import os
 import weakref
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +32,7 @@ from barhinge.analysis.curvature import (
 )
 from barhinge.analysis.forces import bar_axial_forces, panel_membrane_resultants
 from barhinge.errors import ConfigError
+from barhinge.linalg.threads import file_threads
 from barhinge.results import FoldPath
 
 __all__ = [
@@ -39,6 +41,7 @@ __all__ = [
     "state_data",
     "state_mesh",
     "write_state_vtu",
+    "write_state_vtus",
     "write_xdmf",
 ]
 
@@ -335,6 +338,21 @@ def write_state_vtu(path: str | Path, X: np.ndarray | None = None, **kwargs: Any
     path = Path(path)
     state_mesh(X, **kwargs).write(path)
     return path
+
+
+def write_state_vtus(paths: Sequence[str | Path], states: Sequence[StateData]) -> list[Path]:
+    """Write ``states[i]`` to ``paths[i]`` (``.vtu``), several files at a time: meshio's
+    zlib compression, most of a file's time, releases the GIL, so the files are written by
+    :func:`barhinge.linalg.threads.file_threads` threads.
+    An error in any file is raised after the others are finished."""
+    if len(paths) != len(states):
+        raise ValueError(f"{len(paths)} paths for {len(states)} states")
+    workers = min(len(paths), file_threads())
+    if workers <= 1:
+        return [write_state_vtu(p, data=d) for p, d in zip(paths, states, strict=True)]
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        jobs = [pool.submit(write_state_vtu, p, data=d) for p, d in zip(paths, states, strict=True)]
+    return [job.result() for job in jobs]
 
 
 def read_state_vtu(path: str | Path) -> StateData:

@@ -22,7 +22,7 @@ import numpy as np
 
 from barhinge._json import jsonable
 from barhinge.errors import ConfigError
-from barhinge.output.fields import StateData, path_state_data, write_state_vtu, write_xdmf
+from barhinge.output.fields import StateData, path_state_data, write_state_vtus, write_xdmf
 from barhinge.output.folder import MANIFEST, result_folder
 from barhinge.output.summary import run_summary, stop_reason, summary_rows
 from barhinge.output.table import step_table, write_step_table
@@ -194,8 +194,12 @@ def _extras(fold_path, model, cp, out: Path, name: str, vtu: str,
         written["xdmf"] = write_xdmf(out / f"{name}.xdmf", fold_path, states=states)
         written["xdmf_bars"] = out / f"{name}_bars.xdmf"
         n = fold_path.n_states
-        for s in {"all": range(n), "last": [n - 1], "none": []}[vtu]:
-            written["vtu"] = write_state_vtu(out / f"{name}_{s:04d}.vtu", data=states[s])
+        chosen = {"all": range(n), "last": [n - 1], "none": []}[vtu]
+        paths = write_state_vtus(
+            [out / f"{name}_{s:04d}.vtu" for s in chosen], [states[s] for s in chosen]
+        )
+        if paths:
+            written["vtu"] = paths[-1]
     if pictures != "none":
         from barhinge.output.pictures import write_pictures
 

@@ -77,6 +77,16 @@ def test_free_cores_subtracts_the_load(monkeypatch):
     assert threads.free_cores() == 1
 
 
+@pytest.mark.parametrize(("raw", "want"), [("3", 3), ("off", 1), ("auto", 5)])
+def test_field_files_are_written_by_the_policys_threads(monkeypatch, raw, want):
+    """A fixed count is kept, ``off`` writes one file at a time, ``auto`` uses every core the
+    process may run on, whatever the load average (a finished solve's own load)."""
+    monkeypatch.setenv(threads.ENV, raw)
+    monkeypatch.setattr(threads, "cores", lambda: 5)
+    monkeypatch.setattr(threads.os, "getloadavg", lambda: (40.0, 0.0, 0.0))
+    assert threads.file_threads() == want
+
+
 def test_public_calls_run_under_the_policy(monkeypatch):
     """rigid_fold and dof run their dense work with one BLAS thread (read from inside)."""
     monkeypatch.delenv(threads.ENV, raising=False)

@@ -254,3 +254,26 @@ def test_membrane_N_field_of_a_homogeneous_stretch():
     assert np.isnan(data.line_data["membrane_N"]).all()
     mesh = state_mesh(data=data)
     assert any("membrane_N" in k for k in mesh.cell_data)
+
+
+def test_state_files_written_side_by_side_are_the_states(tmp_path, monkeypatch):
+    """Files written by two threads hold each its own state (read back with meshio, against
+    the written arrays); a file that cannot be written raises after the others are done."""
+    from barhinge.output.fields import path_state_data, write_state_vtus
+
+    monkeypatch.setenv("BARHINGE_THREADS", "2")
+    cp, path = simple_fold_path(n_states=6)
+    states = path_state_data(path, pattern=cp)
+    files = write_state_vtus([tmp_path / f"s{i}.vtu" for i in range(6)], states)
+    assert [f.name for f in files] == [f"s{i}.vtu" for i in range(6)]
+    for f, d in zip(files, states, strict=True):
+        m = meshio.read(f)
+        np.testing.assert_array_equal(m.points, d.points)
+        for name, values in d.point_data.items():
+            np.testing.assert_array_equal(m.point_data[name], values)
+    bad = [tmp_path / "a.vtu", tmp_path / "missing" / "b.vtu", tmp_path / "c.vtu"]
+    with pytest.raises(FileNotFoundError):
+        write_state_vtus(bad, states[:3])
+    assert (tmp_path / "a.vtu").exists() and (tmp_path / "c.vtu").exists()
+    with pytest.raises(ValueError, match="2 paths for 3 states"):
+        write_state_vtus(bad[:2], states[:3])
