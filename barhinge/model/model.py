@@ -56,7 +56,14 @@ from barhinge.pattern.crease import CreasePattern
 
 logger = logging.getLogger(__name__)
 
-__all__ = ["BarHingeModel", "Evaluation", "FOLD_LAWS", "MEMBRANES", "plate_bend_scale"]
+__all__ = [
+    "BarHingeModel",
+    "ElementStates",
+    "Evaluation",
+    "FOLD_LAWS",
+    "MEMBRANES",
+    "plate_bend_scale",
+]
 
 FOLD_LAWS = ("linear", "penetration")
 #: the panels' membrane: bars calibrated by one of ``BAR_CALIBRATIONS``, or ``"cst"``, the
@@ -113,6 +120,32 @@ class Evaluation:
     def energy(self) -> float:
         """Total stored energy."""
         return self.energy_bars + self.energy_bend + self.energy_fold
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class ElementStates:
+    """Forces and energies of every element at one state (:meth:`BarHingeModel.element_states`).
+
+    Attributes
+    ----------
+    bar_axial_force : (n_bars,) float
+        Force a bar exerts on its end nodes, ``S |d eps / dx|`` with ``S = dW/deps``; tension
+        > 0 (force).
+    bar_energy : (n_bars,) float
+        Stored energy of each bar (force x length).
+    hinge_angle : (n_hinges,) float
+        Radians, FOLD convention (valley > 0).
+    hinge_moment : (n_hinges,) float
+        ``dW/drho``, couplings included (force x length).
+    hinge_energy : (n_hinges,) float
+        Stored energy of each hinge, half of each coupling's included (force x length).
+    """
+
+    bar_axial_force: np.ndarray
+    bar_energy: np.ndarray
+    hinge_angle: np.ndarray
+    hinge_moment: np.ndarray
+    hinge_energy: np.ndarray
 
 
 def _ro(a: np.ndarray) -> np.ndarray:
@@ -643,6 +676,23 @@ class BarHingeModel:
         _, _, Wb = self.bar_law(eps)
         _, _, Wh = self._hinge_law(hinge_angle(X, self.hinges))
         return Wb, Wh
+
+    def element_states(self, X: np.ndarray) -> ElementStates:
+        """Axial force and energy of every bar, angle, moment and energy of every hinge at
+        ``X``, each computed once with the model's own laws (the result files of every
+        state need all of them; no internal force or tangent is assembled)."""
+        X = self._check_X(X)
+        eps, d = bar_strain_gradient(X, self.bars, self.bar_L0, self.strain)
+        S, _, Wb = self.bar_law(eps)
+        rho = hinge_angle(X, self.hinges)
+        M, _, Wh = self._hinge_law(rho)
+        return ElementStates(
+            bar_axial_force=S * np.linalg.norm(d, axis=1),
+            bar_energy=Wb,
+            hinge_angle=rho,
+            hinge_moment=M,
+            hinge_energy=Wh,
+        )
 
     def internal_force(self, X: np.ndarray) -> np.ndarray:
         """(n_dof,) internal force ``dE/dX``."""

@@ -30,7 +30,7 @@ from barhinge.analysis.curvature import (
     mixed_voronoi_area,
     pattern_triangles,
 )
-from barhinge.analysis.forces import bar_axial_forces, panel_membrane_resultants
+from barhinge.analysis.forces import panel_membrane_resultants
 from barhinge.errors import ConfigError
 from barhinge.linalg.threads import file_threads
 from barhinge.results import FoldPath
@@ -158,13 +158,6 @@ def _triangle_membrane(model: Any, X: np.ndarray, tri_face: np.ndarray) -> np.nd
     return out
 
 
-def _element_energies(model: Any, X: np.ndarray, rho: np.ndarray):
-    """(n_bars,), (n_hinges,) stored energy of every bar and hinge with the model's own laws
-    (per-hinge penetration limits included); ``rho`` is unused, kept for the call sites."""
-    del rho
-    return model.element_energies(X)
-
-
 def _pair_index(pairs: np.ndarray, n: int) -> np.ndarray:
     """Integer key of unordered node pairs."""
     p = np.sort(np.asarray(pairs, np.int64), axis=1)
@@ -229,11 +222,10 @@ def state_data(
         L = np.linalg.norm(X[lines[:, 1]] - X[lines[:, 0]], axis=1)
         L0 = np.asarray(model.bar_L0, float)
         eps = (L - L0) / L0
-        rho = np.asarray(model.hinge_angles(X), float)
-        e_line, e_h = _element_energies(model, X, rho)
-        e_line = e_line / L0  # energy per length
-        bar_force = bar_axial_forces(model, X)
-        hinge_moment = np.asarray(model.evaluate(X, tangent=False).hinge_moment, float)
+        el = model.element_states(X)  # one pass over the elements
+        rho, e_h, hinge_moment = el.hinge_angle, el.hinge_energy, el.hinge_moment
+        e_line = el.bar_energy / L0  # energy per length
+        bar_force = el.bar_axial_force
         # fold hinges: angle and energy on the bar along their axis
         i, hf = topo["line_of_fold"], topo["fold_hinge"]
         fold_ang = np.full(len(lines), np.nan)

@@ -208,6 +208,32 @@ def test_evaluate_split_and_moments() -> None:
     assert m.energy(X.ravel()) == pytest.approx(ev.energy)
 
 
+@pytest.mark.parametrize("mi", range(len(MODELS)))
+def test_element_states_are_the_derivatives_of_the_element_energies(mi: int) -> None:
+    """Each bar's axial force is ``dW_b/dL`` (central difference of its energy as one end
+    moves along the bar), each hinge's moment is the evaluation's ``dW/drho`` and the
+    energies are :meth:`element_energies`; penetration law and engineering strain
+    included."""
+    m = MODELS[mi]
+    X = perturbed(m, 3)
+    el = m.element_states(X)
+    Wb, Wh = m.element_energies(X)
+    # the same strains by two kernels: equal to round-off of the largest energy
+    np.testing.assert_allclose(el.bar_energy, Wb, rtol=0, atol=1e-13 * Wb.max())
+    np.testing.assert_allclose(el.hinge_energy, Wh, rtol=0, atol=1e-13 * Wh.max())
+    ev = m.evaluate(X, tangent=False)
+    np.testing.assert_allclose(el.hinge_angle, ev.hinge_angle, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(el.hinge_moment, ev.hinge_moment, rtol=1e-12, atol=1e-15)
+    h = 1e-6
+    for b, (i, j) in enumerate(m.bars):
+        e = (X[j] - X[i]) / np.linalg.norm(X[j] - X[i])
+        Xp, Xm = X.copy(), X.copy()
+        Xp[j] += h * e
+        Xm[j] -= h * e
+        dW = (m.element_energies(Xp)[0][b] - m.element_energies(Xm)[0][b]) / (2 * h)
+        assert el.bar_axial_force[b] == pytest.approx(dW, rel=1e-6, abs=1e-10)
+
+
 def test_assembly_scatter_pattern_is_reused() -> None:
     m = MODELS[1]
     K1 = m.tangent(perturbed(m, 1))
