@@ -35,7 +35,6 @@ from typing import Any
 import numpy as np
 
 from barhinge.errors import ConfigError
-from barhinge.kernels.geometry import bar_strain_gradient
 from barhinge.model.calibrate import face_frames
 from barhinge.model.topology import build_topology
 from barhinge.model.triangulate import triangulate
@@ -114,9 +113,7 @@ def bar_axial_forces(model: Any, X: np.ndarray) -> np.ndarray:
     bar exerts on its end nodes: ``S |d eps/dx|`` with ``S = dW/deps`` (``EA L0 eps`` for a
     bar, so ``EA eps L / L0`` for Green strain and ``EA eps`` for engineering strain; with
     the CST membrane ``S`` includes the couplings ``(C eps)_b``)."""
-    eps, d = bar_strain_gradient(X, model.bars, model.bar_L0, model.strain)
-    S, _, _ = model.bar_law(eps)
-    return S * np.linalg.norm(d, axis=1)
+    return model.element_states(X).bar_axial_force
 
 
 _FACE_BARS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
