@@ -159,6 +159,23 @@ class SolverOptions:
         the energy-minimising rigid fold on the branch of the M/V assignment
         (:mod:`barhinge.solver.branch`); ``"tangent"`` uses the plain tangent predictor (the
         branch is then whatever Newton finds; use it with an imperfect start).
+    damping : str
+        How the first increment off a flat start is solved when plain Newton fails it.
+        Near flat the folds resist at second order in the fold angle and the bars only at
+        fourth, so the rest of a large sheet is a near-mechanism whose plain Newton
+        corrections overshoot by orders of magnitude (on a 200 x 200 Miura sheet they
+        diverge), and a shorter increment lies farther from the rigid fold, so cutting it
+        back does not help. ``"auto"`` (default): the failed first increment is redone with
+        damped Newton corrections (:mod:`barhinge.solver.damping`) before it is cut back:
+        the tangent's free diagonal is shifted by ``delta``, which follows the residual from
+        one correction to the next (pseudo-transient continuation), a correction that raises
+        the residual more than ten times is redone with a larger shift, and plain Newton
+        takes over once the residual is a thousandth of the first. ``"always"``: the first
+        increment is damped from the start (skips the failed plain attempt on a sheet known
+        to need it). ``"off"``: plain Newton and cut-backs only. Not used under load or
+        arc-length control. The damped corrections may settle on another equilibrium than
+        plain Newton where several lie near the rigid fold; the crease-sign check of the
+        flat start names creases that fold against their assignment.
     """
 
     tol_force: float = 1e-8
@@ -186,6 +203,7 @@ class SolverOptions:
     arc_stop_instability: bool = False
     flat_start: str = "rigid"
     stability_check: bool | None = None
+    damping: str = "auto"
 
     def __post_init__(self) -> None:
         # every field: type (bools are not numbers), finiteness and range; messages start
@@ -214,6 +232,7 @@ class SolverOptions:
             self.predictor, "options.predictor", ("polynomial", "quadratic", "secant", "tangent")
         )
         _check.choice(self.flat_start, "options.flat_start", ("rigid", "tangent"))
+        _check.choice(self.damping, "options.damping", ("auto", "always", "off"))
         _check.choice(self.corrector, "options.corrector", ("chord", "newton"))
         _check.boolean(self.reuse_factorization, "options.reuse_factorization")
         if self.acceleration != "auto":

@@ -10,9 +10,11 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
+import scipy.sparse as sp
 
 from barhinge._protocols import SolverModel
 from barhinge.linalg.backends import SingularMatrixError, get_backend
+from barhinge.linalg.indices import pattern_positions
 from barhinge.solver.bordered import ActuatorTerms, BorderedSystem, Timer, actuator_terms
 from barhinge.solver.diagnose import check_finite_tangent
 from barhinge.solver.state import Evaluation, IncrementFailed, IterationStatus, State
@@ -67,6 +69,9 @@ class SolveContext:
         self.size = float(np.linalg.norm(ext)) or 1.0
         self.force_floor: float | None = self.opts.force_floor
         self.penalty: float | None = None
+        # positions of the free diagonal in the values of K's pattern (the arrays held)
+        self._diag_pos = np.zeros(0, np.int64)
+        self._diag_arrays: tuple[Any, Any] = (None, None)
         self.c_scale = 1.0
         #: told of every iterate (:meth:`iterate`); None: nobody listens
         self.on_iteration: Callable[[IterationStatus], None] | None = None
@@ -174,14 +179,21 @@ class SolveContext:
         return penalty
 
     def factorize(
-        self, e: Evaluation, st: State, reuse: bool = False, keep_operator: bool = False
+        self,
+        e: Evaluation,
+        st: State,
+        reuse: bool = False,
+        keep_operator: bool = False,
+        shift: float = 0.0,
     ) -> None:
         """Make the tangent at ``st`` the operator of the bordered system and factorise it
         (``reuse``: unless the system keeps an earlier factorisation as GMRES
         preconditioner). Unless ``keep_operator`` is set, the operator's values and ``e``'s
         tangent are released where the factor alone serves every later solve (the next
         tangent is then assembled without this one beside it). An ``e`` without its
-        tangent (evaluated without it, or released) has it assembled first."""
+        tangent (evaluated without it, or released) has it assembled first. ``shift``
+        (force / length, >= 0) is added to the free DOFs' diagonal of the operator (damped
+        Newton); ``e``'s tangent itself is left unshifted."""
         self.system.row_scale = self.c_scale
         if e.ev.K is None or e.terms.hess is None:
             # evaluated without the tangent, or released by an earlier factorisation
@@ -192,7 +204,7 @@ class SolveContext:
         if self.k_act is not None:
             springs = (e.mu_act, self.k_act)
         self.system.set_operator(
-            e.ev.K,
+            self._shifted(e.ev.K, shift) if shift else e.ev.K,
             e.terms,
             st.mu,
             self.penalty or 0.0,
@@ -206,13 +218,37 @@ class SolveContext:
             e.ev = dataclasses.replace(cast(Any, e.ev), K=None)
 
     def factorize_or_fail(
-        self, e: Evaluation, st: State, res: list[float], reuse: bool = False
+        self,
+        e: Evaluation,
+        st: State,
+        res: list[float],
+        reuse: bool = False,
+        keep_operator: bool = False,
+        shift: float = 0.0,
     ) -> None:
         """:meth:`factorize`; a singular tangent fails the increment."""
         try:
-            self.factorize(e, st, reuse)
+            self.factorize(e, st, reuse, keep_operator=keep_operator, shift=shift)
         except SingularMatrixError as exc:
             raise IncrementFailed(f"singular tangent ({exc})", res) from None
+
+    def _shifted(self, K: Any, shift: float) -> sp.csr_matrix:
+        """``K + shift I_free``: a copy of K's values on K's own pattern arrays (the
+        bordered system's scatter maps stay valid)."""
+        K.sort_indices()
+        if self._diag_arrays[0] is not K.indptr or self._diag_arrays[1] is not K.indices:
+            idx = np.flatnonzero(self.free)
+            pos = pattern_positions(K.indptr, K.indices, idx, idx)
+            if np.any(pos < 0):
+                raise AssertionError("the tangent's pattern lacks diagonal entries")
+            # the arrays are held, so a new pattern is never mistaken for them
+            self._diag_pos, self._diag_arrays = pos, (K.indptr, K.indices)
+        shifted = sp.csr_matrix(K.shape, dtype=K.dtype)
+        shifted.indices, shifted.indptr = K.indices, K.indptr  # not views: the same arrays
+        shifted.data = K.data.copy()
+        shifted.data[self._diag_pos] += shift
+        shifted.has_sorted_indices = True
+        return shifted
 
 
 def auto_augmentation(K: Any, terms: ActuatorTerms) -> tuple[float, float]:

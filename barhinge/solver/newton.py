@@ -25,6 +25,7 @@ from barhinge.results import FoldPath, Interrupted
 from barhinge.solver.arcrun import run_arc_length
 from barhinge.solver.context import SolveContext
 from barhinge.solver.convergence import Convergence
+from barhinge.solver.damping import Damping
 from barhinge.solver.diagnose import check as check_scene
 from barhinge.solver.flatstart import FlatStart
 from barhinge.solver.records import build_path, make_record
@@ -113,6 +114,8 @@ class _Driver:
         # leaving a flat start: the first increment is predicted by the rigid fold
         # (barhinge.solver.branch); its record says which branch was taken
         self.flat = FlatStart(ctx)
+        self.damping = Damping(ctx, self.conv)
+        self._damp_flat_start = False  # the first increment is solved damped (option damping)
         # per recorded step (state 1 on): Newton iterations of its converged increments,
         # increments (converged, failed), factorisations (all, of them for the inertia)
         self.step_stats: list[StepStats] = []
@@ -136,6 +139,11 @@ class _Driver:
         new = self._predict(st, t1, lam1, res)
         x_pred = new.x.copy()
         e = self._pred_eval if self._pred_eval is not None else ctx.evaluate(new)
+        damped = self._damped(st)
+        if damped:
+            if e.ev.K is None:
+                e = ctx.evaluate(new)
+            self.damping.reset(e)
         dx_last: np.ndarray | None = None
         n_iter = 0  # Newton corrections (each factorises)
         n_chord = 0  # chord corrections kept (solved with the increment's factorisation)
@@ -164,6 +172,11 @@ class _Driver:
                 raise IncrementFailed(f"no convergence in {o.max_iter} iterations", res)
             if len(res) > 2 and rf > o.divergence_ratio * max(res[0], ctx.floor):
                 raise IncrementFailed("residual diverged", res)
+            if damped:
+                new, e, dx_last, n_fact = self.damping.correction(new, e, res)
+                n_iter += n_fact
+                damped = self.damping.delta > 0.0
+                continue
             if n_iter and self._chord_allowed(res):
                 chord = self._chord(new, e, chord_step[0] if chord_step else None)
                 if chord is not None:
@@ -181,6 +194,26 @@ class _Driver:
             light = self._expects_convergence(res)
             new, e, alpha = self.conv.line_search(new, e, dx, dmu, light)
             dx_last = alpha * dx
+
+    def _first_off_flat(self, st: State) -> bool:
+        """Whether the increment from ``st`` is the first off a flat start, under fold-angle
+        or displacement control (where option ``damping`` applies)."""
+        return st.t == 0.0 and self.flat.active and not self.system.track_inertia
+
+    def _damped(self, st: State) -> bool:
+        """Whether the increment from ``st`` is solved by damped corrections (option
+        ``damping``): the first increment off a flat start, once plain Newton has failed it
+        (:meth:`_retry`; ``"auto"``) or from the start (``"always"``)."""
+        if not self._first_off_flat(st):
+            return False
+        return self._damp_flat_start or self.opts.damping == "always"
+
+    def _may_damp(self, st: State) -> bool:
+        """Whether a failed increment from ``st`` may be redone with damped corrections (the
+        first off a flat start, not yet damped, ``damping = "auto"``)."""
+        return (
+            self.opts.damping == "auto" and not self._damp_flat_start and self._first_off_flat(st)
+        )
 
     def _chord_allowed(self, res: list[float]) -> bool:
         """Whether the next correction is first tried as a chord step (option
@@ -337,11 +370,19 @@ class _Driver:
         self.records.append(make_record(self.ctx, st, e, iters, res, wall, self.work.work, *counts))
 
     def path(self, converged: bool = True, message: str = "") -> FoldPath:
+        flat = self.flat.record
+        if flat is not None and self.damping.corrections:
+            # the damped corrections of the first increment (option damping)
+            flat = {
+                **flat,
+                "damped_corrections": self.damping.corrections,
+                "damped_redone": self.damping.rejected,
+            }
         return build_path(
             self.ctx,
             self.records,
             self.step_stats,
-            self.flat.record,
+            flat,
             self.flat.events(self.records),
             converged=converged,
             message=message,
@@ -481,6 +522,15 @@ class _Driver:
             # actuators conflict): the panels must bend, and Newton may not
             # reach that from the rigid prediction; retry from the tangent
             self._retry_tangent = True
+            return True
+        if self._may_damp(st):
+            # plain Newton failed the first increment off a flat start: the sheet is a
+            # near-mechanism there, and a shorter increment lies farther from the rigid
+            # fold; the same increment is redone (and any cut-back of it) with damped
+            # corrections from the rigid prediction
+            self._damp_flat_start = True
+            self._retry_tangent = False
+            log.debug("first increment off the flat start redone with damped corrections")
             return True
         if (
             not self._retry_tangent

@@ -1,0 +1,103 @@
+"""Damped Newton corrections (Levenberg-Marquardt) for a near-mechanism: the first increment
+off a flat start (option ``damping``).
+
+Near flat the folds resist a departure from the rigid fold at second order in the fold
+angle and the bars only at fourth, so most of a large sheet is a near-mechanism: its tangent
+has eigenvalues far below the fold springs' and the residual grows with the cube of the
+motion along them. A plain Newton correction then overshoots along those modes by orders of
+magnitude (residuals 0.16 -> 95 -> 0.026 -> 82 on a 100 x 100 Miura sheet; divergence at
+200 x 200). The damped correction solves ``(K_t + delta I) dx = -r`` on the free DOFs (the
+actuator rows as in plain Newton): a large ``delta`` turns it towards the residual (a short
+step down the energy), a vanishing one gives back Newton's correction. ``delta`` starts at
+``DAMPING_START`` times the mean free diagonal and follows the residual from correction to
+correction (switched evolution relaxation: Mulder & van Leer 1985; Kelley & Keyes 1998,
+SIAM J. Numer. Anal. 35, 508). A correction that raises the residual more than
+``DAMPING_RISE`` times is redone from the same tangent with ``delta`` grown. Once the
+residual has fallen to ``DAMPING_SWITCH`` of the increment's first, plain Newton takes over:
+near the equilibrium the soft modes' eigenvalues are far below any useful shift, and damped
+corrections would stagnate there.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from barhinge.solver.context import SolveContext
+from barhinge.solver.convergence import Convergence
+from barhinge.solver.state import Evaluation, IncrementFailed, State
+
+__all__ = ["DAMPING_START", "Damping"]
+
+#: first shift, as a fraction of the mean |diagonal| of the free tangent (the bars' axial
+#: stiffness dominates it: 1e-5 of it is ~ the fold springs' scale in the quasi-rigid set)
+DAMPING_START = 1e-5
+#: growth of the shift after a rejected correction
+DAMPING_GROW = 4.0
+#: the residual ratio of kept corrections is clipped below at this before it scales the shift
+DAMPING_FALL = 0.05
+#: a correction may raise the residual this many times (non-monotone) before it is redone
+DAMPING_RISE = 10.0
+#: once the residual is this fraction of the increment's first, plain Newton corrections
+#: follow (near the solution the soft modes' eigenvalues fall below any useful shift, and a
+#: damped correction stagnates)
+DAMPING_SWITCH = 1e-3
+#: a shift this many times the first one without a kept correction fails the increment
+DAMPING_CEILING = 1e8
+
+
+class Damping:
+    """The shift of one increment's damped corrections (:meth:`reset` at its start)."""
+
+    def __init__(self, ctx: SolveContext, conv: Convergence) -> None:
+        self.ctx = ctx
+        self.conv = conv
+        self.start = 0.0  # force / length
+        self.delta = 0.0
+        self.m_first = 0.0  # merit of the increment's first iterate, force^2
+        self.corrections = 0  # damped corrections kept, over the solve
+        self.rejected = 0  # corrections redone with a larger shift, over the solve
+
+    def reset(self, e: Evaluation) -> None:
+        """First shift of an increment, from the free diagonal of ``e``'s tangent."""
+        K = e.ev.K
+        if K is None:
+            raise ValueError("the damped increment starts from an evaluation with its tangent")
+        d = np.abs(K.diagonal())[self.ctx.free]
+        self.start = DAMPING_START * (float(d.mean()) if d.size and d.mean() > 0 else 1.0)
+        self.delta = self.start
+        self.m_first = self.conv.merit(e)
+
+    def correction(
+        self, st: State, e: Evaluation, res: list[float]
+    ) -> tuple[State, Evaluation, np.ndarray, int]:
+        """The kept damped correction from ``st``: (new state, its evaluation, the
+        displacement correction, factorisations made). Raises IncrementFailed when no shift
+        up to ``DAMPING_CEILING`` times the first keeps the residual's rise within
+        ``DAMPING_RISE``."""
+        ctx, conv = self.ctx, self.conv
+        free = ctx.free
+        m0 = conv.merit(e)
+        n_fact = 0
+        while True:
+            ctx.factorize_or_fail(e, st, res, keep_operator=True, shift=self.delta)
+            n_fact += 1
+            dx, dmu = ctx.system.solve(-e.r[free], -e.c)
+            trial = State(st.x.copy(), st.mu + dmu, st.lam, st.t)
+            trial.x[free] += dx
+            # with its tangent: a kept correction is followed by another one, mostly
+            et = ctx.evaluate(trial)
+            m1 = conv.merit(et)
+            if np.isfinite(m1) and (m1 < DAMPING_RISE**2 * m0 or conv.passes(et, trial)):
+                # switched evolution relaxation: the shift follows the residual
+                ratio = float(np.sqrt(m1 / m0)) if m0 > 0 else DAMPING_FALL
+                self.delta *= min(max(ratio, DAMPING_FALL), DAMPING_GROW)
+                self.corrections += 1
+                if m1 < DAMPING_SWITCH**2 * self.m_first:
+                    self.delta = 0.0  # Newton's own rate from here
+                return trial, et, dx, n_fact
+            self.rejected += 1
+            self.delta *= DAMPING_GROW
+            if self.delta > DAMPING_CEILING * self.start:
+                raise IncrementFailed(
+                    "damped Newton found no correction lowering the residual", res
+                )
