@@ -99,5 +99,7 @@ class Damping:
             self.delta *= DAMPING_GROW
             if self.delta > DAMPING_CEILING * self.start:
                 raise IncrementFailed(
-                    "damped Newton found no correction lowering the residual", res
+                    f"damped Newton: every shift up to {DAMPING_CEILING:.0e} times the first "
+                    f"raised the residual more than {DAMPING_RISE:g} times",
+                    res,
                 )
