@@ -128,8 +128,9 @@ class _Driver:
         or two (secant) converged states, otherwise a tangent step at ``st`` with the
         prescribed displacements and new targets linearised. Correctors: Newton with the
         analytic tangent and an optional backtracking line search on the merit
-        ``|r_free|^2 + (s c)^2``. An iterate expected to pass the force test is evaluated
-        without the tangent first (assembled afterwards if it does not pass).
+        ``|r_free|^2 + (s c)^2``. An iterate expected to pass the force test, or to be
+        followed by a chord correction, is evaluated without the tangent first (assembled
+        afterwards if a Newton correction needs it).
         """
         o, ctx = self.opts, self.ctx
         free = self.free
@@ -191,7 +192,7 @@ class _Driver:
             dx, dmu = self.system.solve(-e.r[free], -e.c, rtol=rtol)
             if self._accelerate(res):
                 dx, dmu = self._accelerated(new, e, dx, dmu, rtol)
-            light = self._expects_convergence(res)
+            light = self._expects_convergence(res) or self._chord_next(res)
             new, e, alpha = self.conv.line_search(new, e, dx, dmu, light)
             dx_last = alpha * dx
 
@@ -225,6 +226,16 @@ class _Driver:
             and self.system.current_factored
             and not self._accelerate(res)
         )
+
+    def _chord_next(self, res: list[float]) -> bool:
+        """Whether the iterate after the Newton correction just solved needs no tangent
+        unless its residual rises: it is tested for convergence (the next correction a
+        back-substitution with this factorisation) and, failing the test, corrected by a
+        chord step (option ``corrector = "chord"``, corrections not accelerated). Where the
+        guess is wrong the tangent is assembled when it is factorised (a force evaluation
+        lost, a fifth of a tangent assembly); where it is right the iterate that ends an
+        increment costs no tangent."""
+        return self.opts.corrector == "chord" and not self._accelerate(res)
 
     def _chord(
         self,

@@ -4,6 +4,9 @@ of [K_t G^T; G 0] on a real Miura tangent)."""
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -15,6 +18,9 @@ from barhinge.model.model import BarHingeModel
 from barhinge.scene import Scene
 from barhinge.solver.bordered import BorderedSystem, Timer, actuator_terms
 from barhinge.solver_options import SolverOptions
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+from bench_solver import miura_scene  # noqa: E402
 
 
 def _miura_system(fold: float = 30.0, nudge: float = 0.0):
@@ -301,3 +307,40 @@ def test_a_residual_evaluation_skips_the_actuator_hessians_and_factorize_adds_th
     dense = _dense_bordered(full.ev.K, full.terms, ctx.free, st.mu)
     ref = np.linalg.solve(dense, np.concatenate([rx, rc]))
     np.testing.assert_allclose(got, ref, rtol=0, atol=1e-8 * np.abs(ref).max())
+
+
+def test_an_iterate_a_chord_step_follows_is_evaluated_without_its_tangent(monkeypatch):
+    """After a Newton correction that is not accelerated, the next iterate is tested for
+    convergence and, failing the test, chord-corrected: neither needs its tangent, so it is
+    evaluated without one. The path must be identical, bit for bit, to the one with the
+    tangent assembled there, and the tangents assembled fewer: an increment that converges
+    in one correction assembles one tangent, for that correction."""
+    from barhinge.solver import newton
+
+    scene = miura_scene(5, 0.0, 20)  # flat -> 60 deg, quasi-rigid: mostly one correction
+    tangents = [0]
+    evaluate = BarHingeModel.evaluate
+
+    def counted(self, X, tangent=True):
+        tangents[0] += bool(tangent)
+        return evaluate(self, X, tangent=tangent)
+
+    monkeypatch.setattr(BarHingeModel, "evaluate", counted)
+    light = bh.solve(scene)
+    n_light = tangents[0]
+    monkeypatch.setattr(newton._Driver, "_chord_next", lambda self, res: False)
+    tangents[0] = 0
+    full = bh.solve(scene)
+    n_full = tangents[0]
+    np.testing.assert_array_equal(light.X, full.X)
+    np.testing.assert_array_equal(light.actuator_moments, full.actuator_moments)
+    assert light.residual_norms == full.residual_norms
+    # one tangent fewer for every increment that converged in one Newton correction
+    stats = light.meta["newton"]
+    one = sum(1 for k in stats["iterations"] if k == 1)
+    assert one >= 10, one
+    assert n_full - n_light >= one, (n_full, n_light, one)
+    # each Newton factorisation needs one tangent; the first state and the stability
+    # counts of the records add at most one each
+    n_fact = light.meta["timing"]["n_factorizations"]
+    assert n_light <= n_fact + 1 + len(light.X)
