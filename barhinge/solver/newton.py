@@ -233,7 +233,7 @@ class _Driver:
         back-substitution with this factorisation) and, failing the test, corrected by a
         chord step (option ``corrector = "chord"``, corrections not accelerated). Where the
         guess is wrong the tangent is assembled when it is factorised (a force evaluation
-        lost, a fifth of a tangent assembly); where it is right the iterate that ends an
+        lost, about a quarter of a tangent assembly); where it is right the iterate that ends an
         increment costs no tangent."""
         return self.opts.corrector == "chord" and not self._accelerate(res)
 
