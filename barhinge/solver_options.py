@@ -160,22 +160,24 @@ class SolverOptions:
         (:mod:`barhinge.solver.branch`); ``"tangent"`` uses the plain tangent predictor (the
         branch is then whatever Newton finds; use it with an imperfect start).
     damping : str
-        How the first increment off a flat start is solved when plain Newton fails it.
-        Near flat the folds resist at second order in the fold angle and the bars only at
-        fourth, so the rest of a large sheet is a near-mechanism whose plain Newton
-        corrections overshoot by orders of magnitude (on a 200 x 200 Miura sheet they
-        diverge), and a shorter increment lies farther from the rigid fold, so cutting it
-        back does not help. ``"auto"`` (default): the failed first increment is redone with
-        damped Newton corrections (:mod:`barhinge.solver.damping`) before it is cut back:
-        the tangent's free diagonal is shifted by ``delta``, which follows the residual from
-        one correction to the next (pseudo-transient continuation), a correction that raises
-        the residual more than ten times is redone with a larger shift, and plain Newton
-        takes over once the residual is a thousandth of the first. ``"always"``: the first
-        increment is damped from the start (skips the failed plain attempt on a sheet known
-        to need it). ``"off"``: plain Newton and cut-backs only. Not used under load or
-        arc-length control. The damped corrections may settle on another equilibrium than
-        plain Newton where several lie near the rigid fold; the crease-sign check of the
-        flat start names creases that fold against their assignment.
+        How an increment off a flat start is solved when plain Newton fails it. Near flat
+        the folds resist at second order in the fold angle and the bars only at fourth, so
+        the rest of a large sheet is a near-mechanism whose plain Newton corrections
+        overshoot by orders of magnitude (on a 200 x 200 Miura sheet they diverge), and a
+        shorter increment lies farther from the rigid fold, so cutting it back does not
+        help. ``"auto"`` (default): the failed first increment, and a later one that the
+        tangent predictor has failed too, is redone with damped Newton corrections
+        (:mod:`barhinge.solver.damping`) before it is cut back: the tangent's free diagonal
+        is shifted by ``delta``, which follows the residual from one correction to the next
+        (pseudo-transient continuation), a correction that raises the residual more than ten
+        times is redone with a larger shift, and plain Newton takes over once the residual
+        is a thousandth of the one after the first correction, or once the damped
+        corrections stop gaining. ``"always"``: the first increment is damped from the start
+        (skips the failed plain attempt on a sheet known to need it). ``"off"``: plain
+        Newton and cut-backs only. Not used under load or arc-length control. The damped
+        corrections may settle on another equilibrium than plain Newton where several lie
+        near the rigid fold; the crease-sign check of the flat start names creases that
+        fold against their assignment.
     """
 
     tol_force: float = 1e-8

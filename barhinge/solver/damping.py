@@ -1,5 +1,5 @@
-"""Damped Newton corrections (Levenberg-Marquardt) for a near-mechanism: the first increment
-off a flat start (option ``damping``).
+"""Damped Newton corrections (Levenberg-Marquardt) for a near-mechanism: increments off a
+flat start that plain Newton fails (option ``damping``).
 
 Near flat the folds resist a departure from the rigid fold at second order in the fold
 angle and the bars only at fourth, so most of a large sheet is a near-mechanism: its tangent
@@ -12,10 +12,17 @@ step down the energy), a vanishing one gives back Newton's correction. ``delta``
 ``DAMPING_START`` times the mean free diagonal and follows the residual from correction to
 correction (switched evolution relaxation: Mulder & van Leer 1985; Kelley & Keyes 1998,
 SIAM J. Numer. Anal. 35, 508). A correction that raises the residual more than
-``DAMPING_RISE`` times is redone from the same tangent with ``delta`` grown. Once the
-residual has fallen to ``DAMPING_SWITCH`` of the increment's first, plain Newton takes over:
-near the equilibrium the soft modes' eigenvalues are far below any useful shift, and damped
-corrections would stagnate there.
+``DAMPING_RISE`` times is redone from the same tangent with ``delta`` grown. Plain Newton
+takes over (:meth:`Damping._hand_over`) once the residual has fallen to ``DAMPING_SWITCH`` of
+its value after the increment's first kept correction, or once the damped corrections stop
+gaining: near the equilibrium the soft modes' eigenvalues are far below any useful shift,
+and damped corrections stagnate there (or alternate, where the panels bend). The progress is
+measured from the first correction, not from the prediction: the prediction's residual is
+mostly the stretch of its bars, which one correction takes out whatever the soft modes do.
+On the second step of a 200 x 200 Miura fold (residual 1.1e4 predicted, 883 after the first
+correction), Newton measured from the prediction took over at 6.3 and swung between 1.8 and
+5e4 until it diverged eighteen corrections later; measured from the first correction it
+takes over at 0.43 and the increment converges in 12 corrections.
 """
 
 from __future__ import annotations
@@ -37,10 +44,13 @@ DAMPING_GROW = 4.0
 DAMPING_FALL = 0.05
 #: a correction may raise the residual this many times (non-monotone) before it is redone
 DAMPING_RISE = 10.0
-#: once the residual is this fraction of the increment's first, plain Newton corrections
-#: follow (near the solution the soft modes' eigenvalues fall below any useful shift, and a
-#: damped correction stagnates)
+#: once the residual is this fraction of the one after the increment's first kept
+#: correction, plain Newton corrections follow (near the solution the soft modes'
+#: eigenvalues fall below any useful shift, and a damped correction stagnates)
 DAMPING_SWITCH = 1e-3
+#: plain Newton corrections follow as well once the best residual of this many kept
+#: corrections is not below half the best before them (damped corrections alternating)
+DAMPING_PATIENCE = 3
 #: a shift this many times the first one without a kept correction fails the increment
 DAMPING_CEILING = 1e8
 
@@ -53,7 +63,7 @@ class Damping:
         self.conv = conv
         self.start = 0.0  # force / length
         self.delta = 0.0
-        self.m_first = 0.0  # merit of the increment's first iterate, force^2
+        self.kept: list[float] = []  # merits of the increment's kept corrections, force^2
         self.corrections = 0  # damped corrections kept, over the solve
         self.rejected = 0  # corrections redone with a larger shift, over the solve
 
@@ -65,7 +75,7 @@ class Damping:
         d = np.abs(K.diagonal())[self.ctx.free]
         self.start = DAMPING_START * (float(d.mean()) if d.size and d.mean() > 0 else 1.0)
         self.delta = self.start
-        self.m_first = self.conv.merit(e)
+        self.kept = []
 
     def correction(
         self, st: State, e: Evaluation, res: list[float]
@@ -92,7 +102,8 @@ class Damping:
                 ratio = float(np.sqrt(m1 / m0)) if m0 > 0 else DAMPING_FALL
                 self.delta *= min(max(ratio, DAMPING_FALL), DAMPING_GROW)
                 self.corrections += 1
-                if m1 < DAMPING_SWITCH**2 * self.m_first:
+                self.kept.append(m1)
+                if self._hand_over():
                     self.delta = 0.0  # Newton's own rate from here
                 return trial, et, dx, n_fact
             self.rejected += 1
@@ -103,3 +114,14 @@ class Damping:
                     f"raised the residual more than {DAMPING_RISE:g} times",
                     res,
                 )
+
+    def _hand_over(self) -> bool:
+        """Whether plain Newton corrections follow the last kept one: its residual is
+        ``DAMPING_SWITCH`` of the first kept correction's (the first takes out the
+        prediction's bar stretch, so progress is measured from what it leaves), or the damped
+        corrections stopped gaining (the best of the last ``DAMPING_PATIENCE`` is not below
+        half the best before them)."""
+        kept, n = self.kept, DAMPING_PATIENCE
+        if kept[-1] < DAMPING_SWITCH**2 * kept[0]:
+            return True
+        return len(kept) > n and min(kept[-n:]) > 0.25 * min(kept[:-n])

@@ -115,7 +115,9 @@ class _Driver:
         # (barhinge.solver.branch); its record says which branch was taken
         self.flat = FlatStart(ctx)
         self.damping = Damping(ctx, self.conv)
-        self._damp_flat_start = False  # the first increment is solved damped (option damping)
+        # the path parameter of the start state whose increments are solved damped (option
+        # damping; None: none yet)
+        self._damp_from: float | None = None
         # per recorded step (state 1 on): Newton iterations of its converged increments,
         # increments (converged, failed), factorisations (all, of them for the inertia)
         self.step_stats: list[StepStats] = []
@@ -196,24 +198,37 @@ class _Driver:
             new, e, alpha = self.conv.line_search(new, e, dx, dmu, light)
             dx_last = alpha * dx
 
-    def _first_off_flat(self, st: State) -> bool:
-        """Whether the increment from ``st`` is the first off a flat start, under fold-angle
-        or displacement control (where option ``damping`` applies)."""
-        return st.t == 0.0 and self.flat.active and not self.system.track_inertia
+    def _off_flat(self) -> bool:
+        """Whether the path leaves a flat start under fold-angle or displacement control
+        (where option ``damping`` applies)."""
+        return self.flat.active and not self.system.track_inertia
 
     def _damped(self, st: State) -> bool:
         """Whether the increment from ``st`` is solved by damped corrections (option
-        ``damping``): the first increment off a flat start, once plain Newton has failed it
-        (:meth:`_retry`; ``"auto"``) or from the start (``"always"``)."""
-        if not self._first_off_flat(st):
+        ``damping``): an increment of a path off a flat start once plain Newton has failed
+        it (:meth:`_retry`; ``"auto"``), or the first increment from the start
+        (``"always"``)."""
+        if not self._off_flat():
             return False
-        return self._damp_flat_start or self.opts.damping == "always"
+        return self._damp_from == st.t or (st.t == 0.0 and self.opts.damping == "always")
 
     def _may_damp(self, st: State) -> bool:
-        """Whether a failed increment from ``st`` may be redone with damped corrections (the
-        first off a flat start, not yet damped, ``damping = "auto"``)."""
+        """Whether a failed increment from ``st`` may be redone with damped corrections
+        (``damping = "auto"``, a path off a flat start, increments from ``st`` not yet
+        damped): the first increment at once, a later one once the tangent predictor has
+        failed it too."""
         return (
-            self.opts.damping == "auto" and not self._damp_flat_start and self._first_off_flat(st)
+            self.opts.damping == "auto"
+            and self._off_flat()
+            and self._damp_from != st.t
+            and not self._tangent_retry_left()
+        )
+
+    def _tangent_retry_left(self) -> bool:
+        """Whether a failed increment may still be retried with the tangent predictor: an
+        extrapolating predictor made it, and no retry was made yet."""
+        return (
+            not self._retry_tangent and self._prev is not None and self.opts.predictor != "tangent"
         )
 
     def _chord_allowed(self, res: list[float]) -> bool:
@@ -525,8 +540,9 @@ class _Driver:
         return released, held
 
     def _retry(self, st: State) -> bool:
-        """Whether a failed increment from ``st`` is retried at the same length with the
-        tangent predictor (sets the retry flag)."""
+        """Whether a failed increment from ``st`` is retried at the same length: with the
+        tangent predictor (sets the retry flag) or with damped corrections (option
+        ``damping``; sets the start they apply to)."""
         rec = self.flat.record or {}
         if st.t == 0.0 and rec.get("least_squares") and not self._retry_tangent:
             # the rigid fold could only meet the targets in least squares (the
@@ -535,19 +551,15 @@ class _Driver:
             self._retry_tangent = True
             return True
         if self._may_damp(st):
-            # plain Newton failed the first increment off a flat start: the sheet is a
-            # near-mechanism there, and a shorter increment lies farther from the rigid
-            # fold; the same increment is redone (and any cut-back of it) with damped
-            # corrections from the rigid prediction
-            self._damp_flat_start = True
+            # plain Newton failed an increment off a flat start (the first, or a later one
+            # from both predictors): the sheet is a near-mechanism there, and a shorter
+            # increment lies farther from the rigid fold; the same increment is redone (and
+            # any cut-back of it) with damped corrections from the first prediction
+            self._damp_from = st.t
             self._retry_tangent = False
-            log.debug("first increment off the flat start redone with damped corrections")
+            log.debug("increment from t=%.6g redone with damped corrections", st.t)
             return True
-        if (
-            not self._retry_tangent
-            and self._prev is not None
-            and (self.opts.predictor != "tangent")
-        ):
+        if self._tangent_retry_left() and self._damp_from != st.t:
             # an extrapolating predictor failed: retry the same increment once
             # with the tangent predictor before cutting back (near a soft mode
             # the extrapolated start can lie outside Newton's basin)

@@ -10,6 +10,7 @@ import pytest
 import barhinge as bh
 from barhinge.families import miura_line_creases
 from barhinge.solver.context import SolveContext
+from barhinge.solver.damping import Damping
 from barhinge.solver.newton import _Driver
 from barhinge.solver.state import IncrementFailed, State
 from barhinge.solver_options import SolverOptions
@@ -87,3 +88,50 @@ def test_failed_first_increment_is_redone_damped_before_a_cut_back(monkeypatch):
 def test_damping_option_is_checked():
     with pytest.raises(bh.ConfigError, match=r"options\.damping"):
         SolverOptions(damping="levenberg")
+
+
+def test_later_increment_failed_by_both_predictors_is_redone_damped(monkeypatch):
+    """``damping = "auto"``: a later increment of a fold from flat that the extrapolating
+    and then the tangent predictor fail is redone damped at the same length (not cut back),
+    and reaches the equilibrium plain Newton reaches without the failures."""
+    calls: list[tuple[float, float, bool, bool]] = []
+    real = _Driver.increment
+
+    def failing_twice_in_step_3(self, st, t1, lam1):
+        calls.append((st.t, t1, self._retry_tangent, self._damped(st)))
+        if st.t == pytest.approx(0.4) and sum(c[0] == pytest.approx(0.4) for c in calls) <= 2:
+            raise IncrementFailed("residual diverged", [1.0])
+        return real(self, st, t1, lam1)
+
+    monkeypatch.setattr(_Driver, "increment", failing_twice_in_step_3)
+    path = bh.solve(_line_fold(4, 5, "auto"))
+    assert path.converged
+    from_step_3 = [c for c in calls if c[0] == pytest.approx(0.4)]
+    assert [c[2:] for c in from_step_3] == [(False, False), (True, False), (False, True)]
+    assert all(c[1] == pytest.approx(0.6) for c in from_step_3)  # the same length, no cut-back
+    assert not any(damped for t, _, _, damped in calls if t != pytest.approx(0.4))
+    assert path.meta["flat_start"]["damped_corrections"] >= 1
+    assert path.meta["newton"]["failed"][2] == 2
+    monkeypatch.setattr(_Driver, "increment", real)
+    plain = bh.solve(_line_fold(4, 5, "auto"))
+    np.testing.assert_allclose(path.fold_angles_deg, plain.fold_angles_deg, atol=1e-5)
+
+
+def test_damped_corrections_hand_over_to_newton_on_progress_or_stagnation():
+    """The hand-over rule of :class:`Damping`: a residual a thousandth of the first kept
+    correction's (merits are squared residuals), or three kept corrections whose best is not
+    below half the best before them; steady progress keeps the corrections damped."""
+    damping = Damping.__new__(Damping)
+
+    def hands_over(residuals: list[float]) -> bool:
+        damping.kept = [r * r for r in residuals]
+        return damping._hand_over()
+
+    # the 200 x 200 sheet's second step (residuals after each kept correction)
+    steady = [883.0, 71.8, 54.7, 12.2, 6.29, 14.2]
+    assert not any(hands_over(steady[:k]) for k in range(1, len(steady) + 1))
+    assert hands_over([*steady, 0.43])  # below 883 / 1000
+    # alternation around a plateau (panels bending under one actuator)
+    alternating = [1.415, 0.890, 1.333, 0.846]
+    assert not hands_over(alternating[:3])
+    assert hands_over(alternating)
