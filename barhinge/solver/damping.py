@@ -49,8 +49,10 @@ DAMPING_RISE = 10.0
 #: eigenvalues fall below any useful shift, and a damped correction stagnates)
 DAMPING_SWITCH = 1e-3
 #: plain Newton corrections follow as well once the best residual of this many kept
-#: corrections is not below half the best before them (damped corrections alternating)
+#: corrections is not below ``DAMPING_GAIN`` times the best before them (damped corrections
+#: alternating without progress)
 DAMPING_PATIENCE = 3
+DAMPING_GAIN = 0.6
 #: a shift this many times the first one without a kept correction fails the increment
 DAMPING_CEILING = 1e8
 
@@ -119,9 +121,9 @@ class Damping:
         """Whether plain Newton corrections follow the last kept one: its residual is
         ``DAMPING_SWITCH`` of the first kept correction's (the first takes out the
         prediction's bar stretch, so progress is measured from what it leaves), or the damped
-        corrections stopped gaining (the best of the last ``DAMPING_PATIENCE`` is not below
-        half the best before them)."""
+        corrections stopped gaining (the best residual of the last ``DAMPING_PATIENCE`` is
+        not below ``DAMPING_GAIN`` times the best before them)."""
         kept, n = self.kept, DAMPING_PATIENCE
         if kept[-1] < DAMPING_SWITCH**2 * kept[0]:
             return True
-        return len(kept) > n and min(kept[-n:]) > 0.25 * min(kept[:-n])
+        return len(kept) > n and min(kept[-n:]) > DAMPING_GAIN**2 * min(kept[:-n])
