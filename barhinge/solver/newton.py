@@ -56,6 +56,10 @@ AUTO_ACCELERATION_AFTER = 2
 #: force and actuator tests); a chord contracting less would cost more back-substitutions
 #: and force evaluations than the Newton correction (one assembly and factorisation) it saves
 CHORD_CONTRACTION = 0.1
+#: option predictor "polynomial" on a path off a flat start: after an increment that
+#: converged in more than AUTO_ACCELERATION_AFTER corrections, the tangent step is a
+#: candidate of the next whole step too
+TANGENT_CANDIDATE = True
 
 if TYPE_CHECKING:
     from barhinge.scene import Scene
@@ -107,8 +111,14 @@ class _Driver:
         self._hist: list[tuple[float, np.ndarray]] = []
         # the last increment failed or needed many corrections (option acceleration "auto")
         self._hard_last = False
+        # the last increment converged, in more than AUTO_ACCELERATION_AFTER corrections
+        self._slow_last = False
         self._pred_eval: Evaluation | None = None  # the predictor's evaluation, if it made one
         self._retry_tangent = False  # next increment: tangent predictor (after a failure)
+        # the last prediction was the tangent step, taken as the extrapolation's rival
+        self._pred_tangent = False
+        # next increment: the extrapolation alone (its tangent-step candidate failed)
+        self._retry_extrapolation = False
         self.n_iter_last = 0  # Newton corrections of the last converged increment
         self.inertia = InertiaMonitor(ctx)
         # leaving a flat start: the first increment is predicted by the rigid fold
@@ -167,7 +177,7 @@ class _Driver:
 
             if dx_last is not None and self.conv.converged(e, new, dx_last, next_correction):
                 self.n_iter_last = n_iter
-                self._hard_last = n_iter > AUTO_ACCELERATION_AFTER
+                self._hard_last = self._slow_last = n_iter > AUTO_ACCELERATION_AFTER
                 self.inertia.check_inertia(res)
                 self.inertia.check_jump(st, x_pred, new, res)
                 return new, e, res
@@ -215,21 +225,34 @@ class _Driver:
     def _may_damp(self, st: State) -> bool:
         """Whether a failed increment from ``st`` may be redone with damped corrections
         (``damping = "auto"``, a path off a flat start, increments from ``st`` not yet
-        damped): the first increment at once, a later one once the tangent predictor has
-        failed it too."""
+        damped): the first increment at once, a later one once both predictors (the
+        extrapolation and the tangent step) have failed it."""
         return (
             self.opts.damping == "auto"
             and self._off_flat()
             and self._damp_from != st.t
-            and not self._tangent_retry_left()
+            and not self._predictor_retry_left()
         )
 
     def _tangent_retry_left(self) -> bool:
         """Whether a failed increment may still be retried with the tangent predictor: an
         extrapolating predictor made it, and no retry was made yet."""
         return (
-            not self._retry_tangent and self._prev is not None and self.opts.predictor != "tangent"
+            not self._retry_tangent
+            and not self._retry_extrapolation
+            and not self._pred_tangent
+            and self._prev is not None
+            and self.opts.predictor != "tangent"
         )
+
+    def _extrapolation_retry_left(self) -> bool:
+        """Whether a failed increment may still be retried with the extrapolation alone: the
+        tangent step made it as the extrapolation's rival (not as a retry)."""
+        return self._pred_tangent and not self._retry_tangent and not self._retry_extrapolation
+
+    def _predictor_retry_left(self) -> bool:
+        """Whether a failed increment has a predictor left to try at the same length."""
+        return self._tangent_retry_left() or self._extrapolation_retry_left()
 
     def _chord_allowed(self, res: list[float]) -> bool:
         """Whether the next correction is first tried as a chord step (option
@@ -297,13 +320,21 @@ class _Driver:
         self.ctx.timer.n_accelerated += 1
         return dx + 0.5 * a, dmu + 0.5 * amu
 
-    def _polynomial(self, st: State, t1: float, lam1: float) -> State:
+    def _polynomial(self, st: State, t1: float, lam1: float, res: list[float]) -> State:
         """Predictor ``"polynomial"``: the extrapolation of the last converged states of the
         degree they support (:func:`barhinge.linalg.extrapolation.extrapolate`) or the quadratic
         through the last three, whichever has the smaller residual ``|r_free|^2 + (s c)^2``
         (two force evaluations without the tangent; the chosen one is kept for the first
         iteration). Near a bifurcation or a change of branch the high degree can overshoot
-        where the quadratic does not."""
+        where the quadratic does not.
+
+        On a path off a flat start, for a whole step after an increment that converged in
+        more than ``AUTO_ACCELERATION_AFTER`` corrections, the tangent step at ``st`` is a
+        third candidate: where the near-mechanism turns from step to step, the states
+        behind extrapolate past the next one, and the tangent step starts Newton nearer to
+        it (one tangent assembly and one solve with the last factorisation). Not after a
+        failed increment or inside cut-backs, where the retries (:meth:`_retry`) are in
+        charge."""
         ctx, nx = self.ctx, len(st.x)
         cands = [lagrange(self._hist[-3:], t1)]
         z = extrapolate(self._hist, t1)
@@ -318,6 +349,20 @@ class _Driver:
             if best is None or m < best[0]:
                 best = (m, new, e)
         assert best is not None
+        if (
+            TANGENT_CANDIDATE
+            and self._slow_last
+            and (t1 - st.t) * self.scene.steps >= 1.0 - 1e-9
+            and self._off_flat()
+            and not self._retry_extrapolation
+        ):
+            new = self._tangent_step(st, t1, lam1, res)
+            e = ctx.evaluate(new, tangent=False)
+            m = self.conv.merit(e)
+            log.debug("tangent predictor: merit %.3g against the extrapolation's %.3g", m, best[0])
+            if m < best[0]:
+                best = (m, new, e)
+                self._pred_tangent = True
         self._pred_eval = best[2]
         return best[1]
 
@@ -338,9 +383,10 @@ class _Driver:
         """Predicted state at ``t1``: rigid fold off a flat start, extrapolation through
         the last converged states, or a tangent step at ``st``."""
         o, ctx = self.opts, self.ctx
-        free, fixed = self.free, self.fixed
+        fixed = self.fixed
         prev = self._prev
         prev2 = self._prev2
+        self._pred_tangent = False
         extrapolate = o.predictor != "tangent" and not self._retry_tangent
         guided = None
         if self.flat.active and not self._retry_tangent:
@@ -349,7 +395,7 @@ class _Driver:
             return guided
         if prev is not None and prev.t < st.t and extrapolate:
             if o.predictor == "polynomial" and len(self._hist) >= 3:
-                return self._polynomial(st, t1, lam1)
+                return self._polynomial(st, t1, lam1, res)
             if o.predictor != "secant" and prev2 is not None and prev2.t < prev.t:
                 # Lagrange extrapolation through the last three converged states
                 ta, tb, tc = prev2.t, prev.t, st.t
@@ -364,6 +410,13 @@ class _Driver:
             new = State(x, mu, lam1, t1)
             new.x[fixed] = ctx.fixed_coords(t1)
             return new
+        return self._tangent_step(st, t1, lam1, res)
+
+    def _tangent_step(self, st: State, t1: float, lam1: float, res: list[float]) -> State:
+        """The tangent predictor: one linear step at ``st`` to ``t1`` (load factor ``lam1``)
+        with the prescribed displacements and the actuators' new targets linearised, solved
+        with the last factorisation as preconditioner."""
+        ctx, free, fixed = self.ctx, self.free, self.fixed
         e = ctx.evaluate(st)
         du_c = ctx.fixed_coords(t1) - st.x[fixed]
         rhs = -(e.r - (lam1 - st.lam) * e.P)
@@ -490,19 +543,19 @@ class _Driver:
                         "step %d: increment to t=%.6g failed (%s); cutting back", s, t1, f.why
                     )
                     n_failed += 1
-                    self._hard_last = True
+                    self._hard_last, self._slow_last = True, False
                     held = self._last_counts()[1]
                     critical = self.inertia.failure_text(f.why, held) or critical
                     if self._retry(st):
                         continue
-                    self._retry_tangent = False
+                    self._retry_tangent = self._retry_extrapolation = False
                     h = h_try / 2
                     if h < h_min * (1 - 1e-9):
                         # near a critical point the smallest increments may simply find no
                         # solution; name the critical point if one was detected on the way
                         raise self.fail(s, st.lam, critical or f.why, f.residuals) from None
                     continue
-                self._retry_tangent = False
+                self._retry_tangent = self._retry_extrapolation = False
                 self.work.add(self.records[0], new, e_new, None)
                 critical = ""
                 self._prev2, self._prev, st = self._prev, st, new
@@ -556,8 +609,13 @@ class _Driver:
             # increment lies farther from the rigid fold; the same increment is redone (and
             # any cut-back of it) with damped corrections from the first prediction
             self._damp_from = st.t
-            self._retry_tangent = False
+            self._retry_tangent = self._retry_extrapolation = False
             log.debug("increment from t=%.6g redone with damped corrections", st.t)
+            return True
+        if self._extrapolation_retry_left() and self._damp_from != st.t:
+            # the tangent step, taken for its smaller residual, failed: retry the same
+            # increment from the extrapolation before cutting back
+            self._retry_extrapolation = True
             return True
         if self._tangent_retry_left() and self._damp_from != st.t:
             # an extrapolating predictor failed: retry the same increment once
