@@ -320,7 +320,7 @@ class _Driver:
         self.ctx.timer.n_accelerated += 1
         return dx + 0.5 * a, dmu + 0.5 * amu
 
-    def _polynomial(self, st: State, t1: float, lam1: float, res: list[float]) -> State:
+    def _polynomial(self, st: State, t1: float, lam1: float) -> State:
         """Predictor ``"polynomial"``: the extrapolation of the last converged states of the
         degree they support (:func:`barhinge.linalg.extrapolation.extrapolate`) or the quadratic
         through the last three, whichever has the smaller residual ``|r_free|^2 + (s c)^2``
@@ -332,9 +332,9 @@ class _Driver:
         more than ``AUTO_ACCELERATION_AFTER`` corrections, the tangent step at ``st`` is a
         third candidate: where the near-mechanism turns from step to step, the states
         behind extrapolate past the next one, and the tangent step starts Newton nearer to
-        it (one tangent assembly and one solve with the last factorisation). Not after a
-        failed increment or inside cut-backs, where the retries (:meth:`_retry`) are in
-        charge."""
+        it (one force evaluation and one back-substitution with the last factorisation).
+        Not after a failed increment or inside cut-backs, where the retries
+        (:meth:`_retry`) are in charge."""
         ctx, nx = self.ctx, len(st.x)
         cands = [lagrange(self._hist[-3:], t1)]
         z = extrapolate(self._hist, t1)
@@ -356,15 +356,38 @@ class _Driver:
             and self._off_flat()
             and not self._retry_extrapolation
         ):
-            new = self._tangent_step(st, t1, lam1, res)
-            e = ctx.evaluate(new, tangent=False)
-            m = self.conv.merit(e)
-            log.debug("tangent predictor: merit %.3g against the extrapolation's %.3g", m, best[0])
-            if m < best[0]:
-                best = (m, new, e)
-                self._pred_tangent = True
+            tangent = self._chord_tangent_step(st, t1, lam1)
+            if tangent is not None:
+                e = ctx.evaluate(tangent, tangent=False)
+                m = self.conv.merit(e)
+                log.debug("tangent step: merit %.3g against the extrapolation's %.3g", m, best[0])
+                if m < best[0]:
+                    best = (m, tangent, e)
+                    self._pred_tangent = True
         self._pred_eval = best[2]
         return best[1]
+
+    def _chord_tangent_step(self, st: State, t1: float, lam1: float) -> State | None:
+        """The tangent step at ``st`` solved with the last factorisation (that of the
+        increment that ended at ``st``): one force evaluation and one back-substitution. None
+        where no factorisation is at hand or prescribed displacements move (their
+        ``-K_fc du_c`` needs the tangent)."""
+        ctx, free, fixed = self.ctx, self.free, self.fixed
+        if not self.system.current_factored:
+            return None
+        du_c = ctx.fixed_coords(t1) - st.x[fixed]
+        if du_c.size and np.any(du_c):
+            return None
+        e = ctx.evaluate(st, tangent=False)
+        rhs = -(e.r - (lam1 - st.lam) * e.P)
+        c_pred = e.c + (ctx.targets(st.t) - ctx.targets(t1)) if ctx.n_act else e.c
+        if ctx.k_act is not None:  # compliant actuators: their springs' ends move
+            rhs = rhs + e.terms.G.T @ (ctx.k_act * (ctx.targets(t1) - ctx.targets(st.t)))
+        dx, dmu = self.system.solve(rhs[free], -c_pred)
+        new = State(st.x.copy(), st.mu + dmu, lam1, t1)
+        new.x[free] += dx
+        new.x[fixed] = ctx.fixed_coords(t1)
+        return new
 
     def _accelerate(self, res: list[float]) -> bool:
         """Whether the next correction is accelerated (option ``acceleration``): always,
@@ -395,7 +418,7 @@ class _Driver:
             return guided
         if prev is not None and prev.t < st.t and extrapolate:
             if o.predictor == "polynomial" and len(self._hist) >= 3:
-                return self._polynomial(st, t1, lam1, res)
+                return self._polynomial(st, t1, lam1)
             if o.predictor != "secant" and prev2 is not None and prev2.t < prev.t:
                 # Lagrange extrapolation through the last three converged states
                 ta, tb, tc = prev2.t, prev.t, st.t

@@ -55,10 +55,10 @@ def test_the_candidate_reaches_the_same_equilibria(folds) -> None:
 
 
 def test_the_candidate_saves_the_failed_increments_near_flat(folds) -> None:
-    """On the compliant 20 x 20 sheet the extrapolation of steps 3-5 overshoots the turning
+    """On the compliant 20 x 20 sheet the extrapolation of steps 4-6 overshoots the turning
     near-mechanism: without the candidate, increments of the first steps fail and are
     redone (measured 2, at steps 4 and 5); with it, none fails and the first steps need
-    fewer factorisations (measured 70 -> 49 in steps 1-6, 136 -> 120 over the fold)."""
+    fewer factorisations (measured 70 -> 44 in steps 1-6, 136 -> 110 over the fold)."""
     cand, plain = folds
     f_cand = cand.meta["newton"]["failed"][:FIRST_STEPS]
     f_plain = plain.meta["newton"]["failed"][:FIRST_STEPS]
