@@ -379,15 +379,9 @@ class _Driver:
         if du_c.size and np.any(du_c):
             return None
         e = ctx.evaluate(st, tangent=False)
-        rhs = -(e.r - (lam1 - st.lam) * e.P)
-        c_pred = e.c + (ctx.targets(st.t) - ctx.targets(t1)) if ctx.n_act else e.c
-        if ctx.k_act is not None:  # compliant actuators: their springs' ends move
-            rhs = rhs + e.terms.G.T @ (ctx.k_act * (ctx.targets(t1) - ctx.targets(st.t)))
+        rhs, c_pred = self._tangent_rhs(e, st, t1, lam1, None)
         dx, dmu = self.system.solve(rhs[free], -c_pred)
-        new = State(st.x.copy(), st.mu + dmu, lam1, t1)
-        new.x[free] += dx
-        new.x[fixed] = ctx.fixed_coords(t1)
-        return new
+        return self._stepped(st, dx, dmu, t1, lam1)
 
     def _accelerate(self, res: list[float]) -> bool:
         """Whether the next correction is accelerated (option ``acceleration``): always,
@@ -441,20 +435,35 @@ class _Driver:
         with the last factorisation as preconditioner."""
         ctx, free, fixed = self.ctx, self.free, self.fixed
         e = ctx.evaluate(st)
-        du_c = ctx.fixed_coords(t1) - st.x[fixed]
+        rhs, c_pred = self._tangent_rhs(e, st, t1, lam1, ctx.fixed_coords(t1) - st.x[fixed])
+        ctx.factorize_or_fail(e, st, res, reuse=True)
+        dx, dmu = self.system.solve(rhs[free], -c_pred, rtol=1e-6)
+        return self._stepped(st, dx, dmu, t1, lam1)
+
+    def _tangent_rhs(
+        self, e: Evaluation, st: State, t1: float, lam1: float, du_c: np.ndarray | None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Right-hand sides (forces, constraints) of the tangent step at ``st`` (evaluated
+        as ``e``) to ``t1``: the load increment, the prescribed displacements ``du_c`` of the
+        fixed DOFs (``-K_fc du_c``; needs ``e``'s tangent, None: none), the actuators' new
+        targets and, for compliant actuators, their springs' moved ends."""
+        ctx = self.ctx
         rhs = -(e.r - (lam1 - st.lam) * e.P)
-        if du_c.size and np.any(du_c):
+        if du_c is not None and du_c.size and np.any(du_c):
             dfull = np.zeros(ctx.n_dof)
-            dfull[fixed] = du_c
+            dfull[self.fixed] = du_c
             rhs = rhs - e.ev.K @ dfull
         c_pred = e.c + (ctx.targets(st.t) - ctx.targets(t1)) if ctx.n_act else e.c
         if ctx.k_act is not None:  # compliant actuators: their springs' ends move
             rhs = rhs + e.terms.G.T @ (ctx.k_act * (ctx.targets(t1) - ctx.targets(st.t)))
-        ctx.factorize_or_fail(e, st, res, reuse=True)
-        dx, dmu = self.system.solve(rhs[free], -c_pred, rtol=1e-6)
+        return rhs, c_pred
+
+    def _stepped(self, st: State, dx: np.ndarray, dmu: np.ndarray, t1: float, lam1: float) -> State:
+        """``st`` moved by ``(dx, dmu)`` on the free DOFs and multipliers, at ``t1`` (load
+        factor ``lam1``) with the fixed DOFs at their prescribed place."""
         new = State(st.x.copy(), st.mu + dmu, lam1, t1)
-        new.x[free] += dx
-        new.x[fixed] = ctx.fixed_coords(t1)
+        new.x[self.free] += dx
+        new.x[self.fixed] = self.ctx.fixed_coords(t1)
         return new
 
     # ------------------------------------------------------------ records
