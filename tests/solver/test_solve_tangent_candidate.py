@@ -1,6 +1,6 @@
-"""The tangent step as a candidate of the polynomial predictor after a hard increment off a
-flat start (:meth:`barhinge.solver.newton._Driver._polynomial`): the same equilibria,
-reached without the failed increments of extrapolation."""
+"""The tangent step as a candidate of the polynomial predictor for a whole step after a slow
+increment off a flat start (:meth:`barhinge.solver.newton._Driver._polynomial`): the same
+equilibria, reached without the failed increments of extrapolation."""
 
 from __future__ import annotations
 
