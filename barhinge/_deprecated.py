@@ -9,6 +9,7 @@ old name                       new name
 ``barhinge.control``           ``barhinge.actuators.curves``
 ``barhinge.plot.control``      ``barhinge.plot.curves``
 ``barhinge.analysis.summary``  ``barhinge.analysis.final_state``
+``barhinge.output.fields``     ``barhinge.fields``
 =============================  ==================================
 
 An old module name (or a sub-module under an old package name) is the new module object
@@ -36,6 +37,7 @@ RENAMED_MODULES: dict[str, str] = {
     "barhinge.control": "barhinge.actuators.curves",
     "barhinge.plot.control": "barhinge.plot.curves",
     "barhinge.analysis.summary": "barhinge.analysis.final_state",
+    "barhinge.output.fields": "barhinge.fields",
 }
 
 

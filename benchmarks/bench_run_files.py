@@ -24,7 +24,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from bench_solver import miura_scene  # noqa: E402
 
 from barhinge.analysis.final_state import final_state_results  # noqa: E402
-from barhinge.output.fields import path_state_data, write_state_vtus, write_xdmf  # noqa: E402
+from barhinge.fields import path_state_data, write_state_vtus, write_xdmf  # noqa: E402
 from barhinge.output.run import write_run  # noqa: E402
 from barhinge.pattern.fold import write_fold_path  # noqa: E402
 from barhinge.results import FoldPath  # noqa: E402

@@ -31,7 +31,7 @@ def rooms():
     """(layer names bottom first, boxes by layer, arrows between boxes).
 
     A box is a package folder, or a top-level module; a module kept in a package of another
-    layer (``output/fields.py``) gets a box of its own.
+    layer would get a box of its own.
     """
     arch = _architecture()
     graph = arch.import_graph()

@@ -56,22 +56,14 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("scene", ["barhinge.solver_options", "barhinge.loads", "barhinge.scene"]),
     ("solver", ["barhinge.solver", "barhinge.solver.*"]),
     ("analysis", ["barhinge.analysis", "barhinge.analysis.*"]),
-    # what output/ writes, as data: fields on the mesh (meshio), the step table, the summary,
-    # the result folder; below the pictures, which draw those fields
-    (
-        "output data",
-        [
-            "barhinge.output.fields",
-            "barhinge.output.table",
-            "barhinge.output.summary",
-            "barhinge.output.folder",
-            "barhinge.output.modes",
-        ],
-    ),
+    # fields on the mesh of a state and their VTU/XDMF files (meshio): drawn by the
+    # pictures, shown by the viewer, written by output/
+    ("fields", ["barhinge.fields"]),
     ("plot", ["barhinge.plot", "barhinge.plot.*"]),
-    # the interactive HTML viewer of a result folder (it reads the output data files)
+    # the interactive HTML viewer of a result folder (it reads the fields' files)
     ("view", ["barhinge.view", "barhinge.view.*"]),
-    # the one writer of a run (run.py: files, pictures, the viewer) and its pictures
+    # everything a run writes: the writer (run.py: files, pictures, the viewer), the step
+    # table, the summary, the result folder, the mode files and the pictures
     ("output", ["barhinge.output", "barhinge.output.*"]),
     ("apps", ["barhinge.verify", "barhinge.sweep"]),
     ("cli", ["barhinge.cli", "barhinge.__main__"]),

@@ -45,6 +45,7 @@ def _restore_package_attributes():
         ("barhinge.solve.controls", "barhinge.solver.bordered"),
         ("barhinge.control", "barhinge.actuators.curves"),
         ("barhinge.plot.control", "barhinge.plot.curves"),
+        ("barhinge.output.fields", "barhinge.fields"),
     ],
 )
 def test_old_module_name_warns_and_is_the_new_module(old: str, new: str) -> None:

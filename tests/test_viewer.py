@@ -13,7 +13,7 @@ import pytest
 
 import barhinge as bh
 from barhinge.cli import main
-from barhinge.output.fields import state_data
+from barhinge.fields import state_data
 from barhinge.scene import default_scene
 from barhinge.view import load_view_data, viewer_html, write_viewer
 from barhinge.view.data import _node_area
@@ -60,7 +60,7 @@ def test_lumped_energy_is_the_stored_energy(run):
 def test_run_writer_view_from_its_states_is_the_view_read_back(run):
     """The run writer hands the viewer the fields it wrote instead of reading its VTU files
     back: the view is the same."""
-    from barhinge.output.fields import path_state_data
+    from barhinge.fields import path_state_data
 
     scene, path, out = run
     states = path_state_data(path, model=scene.model, pattern=scene.model.pattern)

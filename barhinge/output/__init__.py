@@ -5,8 +5,12 @@
 * ``folder`` -- the atomic result folder and its manifest ``barhinge-run.json``;
 * ``summary`` -- ``summary.json`` and the lines ``barhinge fold`` prints;
 * ``table`` -- the step table ``states.csv``;
-* ``fields`` -- fields on the mesh of a state, VTU and XDMF files (meshio);
+* ``modes`` -- one VTU per buckling or stiffness mode;
 * ``pictures`` -- the standard pictures (drawn by :mod:`barhinge.plot`).
+
+The fields on the mesh of a state and their VTU / XDMF files are :mod:`barhinge.fields`
+(below the pictures and the viewer, which draw them); ``state_data`` and ``state_mesh`` are
+also named here.
 
 docs/outputs.md lists every file with its columns and units. The names below load their
 module on first use.
@@ -29,8 +33,8 @@ _EXPORTS = {
     "result_folder": "folder",
     "run_summary": "summary",
     "step_table": "table",
-    "state_data": "fields",
-    "state_mesh": "fields",
+    "state_data": "barhinge.fields",
+    "state_mesh": "barhinge.fields",
     "write_pictures": "pictures",
 }
 
@@ -39,5 +43,7 @@ __all__ = sorted(_EXPORTS)
 
 def __getattr__(name: str) -> Any:
     if name in _EXPORTS:
-        return getattr(importlib.import_module(f"barhinge.output.{_EXPORTS[name]}"), name)
+        module = _EXPORTS[name]
+        full = module if module.startswith("barhinge.") else f"barhinge.output.{module}"
+        return getattr(importlib.import_module(full), name)
     raise AttributeError(f"module 'barhinge.output' has no attribute {name!r}")

@@ -22,7 +22,7 @@ import numpy as np
 
 from barhinge._json import jsonable
 from barhinge.errors import ConfigError
-from barhinge.output.fields import StateData, path_state_data, write_state_vtus, write_xdmf
+from barhinge.fields import StateData, path_state_data, write_state_vtus, write_xdmf
 from barhinge.output.folder import MANIFEST, result_folder
 from barhinge.output.summary import run_summary, stop_reason, summary_rows
 from barhinge.output.table import step_table, write_step_table

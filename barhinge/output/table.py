@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from barhinge.analysis.curvature import fit_quadratic, reference_points
-from barhinge.output.fields import StateData, state_data
+from barhinge.fields import StateData, state_data
 from barhinge.results import FoldPath
 
 __all__ = ["COLUMNS", "actuator_columns", "step_table", "write_step_table"]
@@ -68,7 +68,7 @@ def step_table(
         Default ``model.pattern``; without a model it gives the mesh of a rigid path, and
         (with 6 faces or more) the global form whose Gaussian curvature ``K_global`` is fitted.
     states : list of StateData, optional
-        :func:`~barhinge.output.fields.path_state_data` of the path when already computed
+        :func:`~barhinge.fields.path_state_data` of the path when already computed
         (the run writer shares it with the field files).
     """
     cp = pattern if pattern is not None else getattr(model, "pattern", None)

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from barhinge.errors import BarhingeError, ConfigError
-from barhinge.output.fields import StateData, state_data
+from barhinge.fields import StateData, state_data
 
 __all__ = [
     "RenderError",
@@ -553,7 +553,7 @@ def render_state(
     path : path
         Output PNG.
     model, pattern : optional
-        Mesh and data source (see :func:`barhinge.output.fields.state_data`); one is required.
+        Mesh and data source (see :func:`barhinge.fields.state_data`); one is required.
     scalars : str or array or None
         A name of :data:`ARRAYS` (``fold_angle_deg`` colours the creases, ``angle_defect`` /
         ``defect_density`` / ``displacement`` the nodes, ``energy_density`` the panels), or

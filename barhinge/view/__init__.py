@@ -45,7 +45,7 @@ def write_viewer(
     **kwargs
         ``model``, ``scene``, ``pattern``, ``fixed``, ``loads``, ``title`` for a FoldPath;
         ``pattern`` and ``states`` for a result folder (the crease pattern of its
-        ``fold_path.fold`` and the :class:`~barhinge.output.fields.StateData` of its VTU
+        ``fold_path.fold`` and the :class:`~barhinge.fields.StateData` of its VTU
         files, which are then not read back).
 
     Returns

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from barhinge.errors import ConfigError
-from barhinge.output.fields import StateData, read_state_vtu, state_data
+from barhinge.fields import StateData, read_state_vtu, state_data
 from barhinge.pattern.fold import read_fold, read_fold_path
 from barhinge.plot.charts import control_axis
 from barhinge.results import FoldPath
@@ -97,7 +97,7 @@ def node_energy_density(d: StateData, bar_L0: np.ndarray, node_area: np.ndarray)
     """(n_nodes,) stored energy per unit area, lumped to the nodes.
 
     Each bar's energy (with the fold hinge along it: ``energy_density * L0`` of a line of
-    :func:`barhinge.output.fields.state_data`) goes half to each end; each panel's bending energy
+    :func:`barhinge.fields.state_data`) goes half to each end; each panel's bending energy
     (``energy_density * area``) a third to each corner; a node's sum is divided by its
     ``node_area`` (a third of the reference area of its triangles). So
     ``sum(density * node_area)`` is the total stored energy of the state.

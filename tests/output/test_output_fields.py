@@ -10,7 +10,7 @@ import pytest
 
 from barhinge import CreasePattern, FoldPath
 from barhinge.errors import ConfigError
-from barhinge.output.fields import state_data
+from barhinge.fields import state_data
 from barhinge.output.run import write_results
 from barhinge.output.table import COLUMNS, actuator_columns
 
@@ -195,7 +195,7 @@ def test_vtu_force_fields_match_the_strains_and_fold_angles(tmp_path):
 
     import barhinge as bh
     from barhinge.families import miura_line_creases
-    from barhinge.output.fields import write_state_vtu
+    from barhinge.fields import write_state_vtu
     from barhinge.scene import Scene
 
     cp = bh.families.miura(2, 2, fold=20.0)
@@ -236,7 +236,7 @@ def test_membrane_N_field_of_a_homogeneous_stretch():
     plane-stress resultant t E / (1 - nu^2) (E_xx, nu E_xx, 0) of the Green strain
     E_xx = e + e^2 / 2 (Timoshenko & Goodier: plane stress), in global axes."""
     import barhinge as bh
-    from barhinge.output.fields import state_mesh
+    from barhinge.fields import state_mesh
 
     cp = bh.families.miura(nx=2, ny=2, fold=0.0)
     mat = bh.Material(E=1e6, nu=0.3, t=0.01)
@@ -259,7 +259,7 @@ def test_membrane_N_field_of_a_homogeneous_stretch():
 def test_state_files_written_side_by_side_are_the_states(tmp_path, monkeypatch):
     """Files written by two threads hold each its own state (read back with meshio, against
     the written arrays); a file that cannot be written raises after the others are done."""
-    from barhinge.output.fields import path_state_data, write_state_vtus
+    from barhinge.fields import path_state_data, write_state_vtus
 
     monkeypatch.setenv("BARHINGE_THREADS", "2")
     cp, path = simple_fold_path(n_states=6)
