@@ -195,6 +195,9 @@ class RigidSolver:
         self.iterations = 0
         #: corrector attempts stopped by a singular Jacobian at a bifurcation point
         self.singular_attempts = 0
+        #: whether the last attempt rejected was a converged corrector that fell back to the
+        #: flat state with released actuators pulled away from it (no equilibrium of theirs)
+        self.fell_flat = False
         self.last_guess: np.ndarray | None = None
 
     # ---------------------------------------------------------------- linear algebra
@@ -978,6 +981,14 @@ def rigid_fold(
                     f"leave did not reach a minimum in {opt.energy_max_iter} Newton iterations "
                     f"after {opt.max_cutbacks} cut-backs; drive more creases"
                 )
+            elif solver.fell_flat:
+                msg = (
+                    f"step {s}: the corrector closed every loop only by falling back to the "
+                    f"flat state, where the released actuators' springs are not in "
+                    f"equilibrium, after {opt.max_cutbacks} cut-backs (targets met in least "
+                    f"squares or by compliant actuators); drive fewer creases or make their "
+                    f"targets agree"
+                )
             elif solver.singular_attempts > singular_before:
                 msg = (
                     f"step {s}: the Jacobian of the free creases is singular near the path "
@@ -1122,10 +1133,12 @@ def _advance(
             over = -1
         if ok and solver.lands_flat(new, b):
             new = np.zeros_like(new)
+        solver.fell_flat = False
         if ok and solver.soft and np.max(np.abs(new), initial=0.0) < FLAT_TOL and np.any(b):
             # released actuators pulled towards non-zero targets never rest flat: a landing
             # there (the flat state closes every loop) is a corrector artefact; cut back
             ok = False
+            solver.fell_flat = True
         if ok and np.max(np.abs(new), initial=0.0) >= FLAT_TOL:
             if solver.underactuated is None:
                 solver.dof_rank = _actuator_rank(solver.rc, new, solver.act)

@@ -86,3 +86,23 @@ def test_the_documented_example_runs(capsys):
     assert len(blocks) == 1
     exec(compile(blocks[0], "docs/kinematics.md", "exec"), {})
     assert float(capsys.readouterr().out.split()[-1]) > 1.0
+
+
+def test_a_fold_that_falls_back_to_flat_says_so():
+    """Compliant actuators whose targets no rigid fold off the flat state meets (a 5 x 5
+    Miura sheet with 27 actuators on two crossing section lines, targets of mixed sign from
+    the transformation study's control-surface design at beta = 5 deg, kx L = 3, ky L = 2.8):
+    the least-squares corrector closes every loop only at the flat state, which is not an
+    equilibrium of the actuator springs. The error says that, not that the loop-closure
+    residual failed to close (it closed, to 3e-14)."""
+    from barhinge.errors import ConvergenceError
+
+    edges = [166, 167, 168, 169, 170, 171, 172, 173, 174, 115, 14, 126, 25, 137]
+    edges += [34, 148, 45, 159, 54, 65, 181, 74, 192, 85, 203, 94, 214]
+    targets = [1.5, 13.1, 6.1, 19.4, 11.0, 19.4, 6.1, 13.1, 1.5, -2.5, 7.9, -1.6, 9.0, -0.3]
+    targets += [10.5, 1.3, 12.1, 2.7, 16.9, 16.0, 1.3, 10.5, -0.3, 9.0, -1.6, 7.9, -2.5]
+    acts = bh.Actuators(edges=edges, targets_deg=targets, stiffness=100.0)
+    with pytest.raises(ConvergenceError, match="falling back to the flat state") as err:
+        bh.rigid_fold(bh.families.miura(5, 5), acts, steps=8)
+    assert "did not close" not in str(err.value)
+    assert err.value.step == 0  # nothing converged: the first step failed
