@@ -24,6 +24,11 @@ form, incompatible targets included. Derivatives by the chain rule: the exact se
 of the rigid limit to the actuator targets times the derivatives of the targets to the
 control (``s_i`` for beta; central differences of the explicit turning-angle map for the
 curvatures, no rigid fold).
+
+A trial the rigid limit cannot fold (a crease locked at +-180 deg, a fold that falls back to
+the flat state) gets the residual ``TRIAL_PENALTY``: the trust region rejects the step and the
+search goes on. The result lists those trials (``failed_trials``), and the reason of a design
+that misses its target names them. A start that cannot be folded fails the run.
 """
 
 from __future__ import annotations
@@ -34,6 +39,8 @@ from collections.abc import Callable
 import numpy as np
 import transform as T
 
+from barhinge.errors import BarhingeError
+
 #: target surfaces ``z = f(x, y; kx, ky)`` (x, y from the sheet's centre; kx, ky 1/length)
 SURFACES: dict[str, Callable[..., np.ndarray]] = {
     "paraboloid": lambda x, y, kx, ky: 0.5 * (kx * x * x + ky * y * y),
@@ -43,6 +50,10 @@ SURFACES: dict[str, Callable[..., np.ndarray]] = {
 
 #: reached: both principal curvatures within this fraction of max(|k1 L|, |k2 L|) of target
 TOL = 0.05
+
+#: scaled residual of a trial the rigid limit cannot fold (1 is a 100 % misfit): the
+#: trust region rejects the step and shrinks, and the search goes on from the last point
+TRIAL_PENALTY = 1e3
 
 
 def _sheet(cp) -> tuple[np.ndarray, float]:
@@ -178,19 +189,29 @@ def design(
     n_eval = [0]
     seen_K: list[float] = []
     cache: dict = {}
+    failed: list[str] = []  # trials the rigid limit cannot fold, with the reason
 
     def evaluate(m: np.ndarray, want_jac: bool):
         key = m.tobytes()
-        if key not in cache or (want_jac and cache[key][1] is None):
+        if key not in cache or (want_jac and cache[key][1] is None and cache[key][0] is not None):
             n_eval[0] += 1
             cache.clear()
-            cache[key] = fwd(m, want_jac)
+            try:
+                cache[key] = fwd(m, want_jac)
+            except BarhingeError as exc:
+                if n_eval[0] == 1:
+                    raise  # the start itself: nothing to search from
+                at = f" at {np.round(m, 3).tolist()}" if len(m) <= 3 else ""
+                failed.append(f"{at}: {str(exc).splitlines()[0]}")
+                cache[key] = (None, None)
+                return cache[key]
             k = cache[key][0]
             seen_K.append(float(k[0] * k[1]))
         return cache[key]
 
     def residual(m: np.ndarray) -> np.ndarray:
-        return (evaluate(m, jac == "exact")[0] - t) / scale
+        k = evaluate(m, jac == "exact")[0]
+        return np.full(2, TRIAL_PENALTY) if k is None else (k - t) / scale
 
     def jacobian(m: np.ndarray) -> np.ndarray:
         return evaluate(m, True)[1] * s / scale
@@ -225,6 +246,8 @@ def design(
         )
     else:
         reason = "a local minimum of the misfit: the target lies outside the forms reached"
+    if failed and reason is not None:
+        reason += f" ({len(failed)} trial(s) could not be folded; the first{failed[0]})"
     label = "rigid limit (energy-minimising)"
     if control == "surface":
         label += f", compliant actuators {T.COMPLIANT_K:g} x stiffest fold"
@@ -246,6 +269,7 @@ def design(
         "reason": reason,
         "angles_deg": np.round(s * sol.x, 6) if control == "actuators" else None,
         "evaluations": n_eval[0],
+        "failed_trials": failed,
         "iterations": int(sol.nfev),
         "seconds": seconds,
         "optimizer": sol.message,

@@ -151,6 +151,36 @@ def test_inverse_design_reaches_an_arch_and_says_why_a_miura_cannot_be_a_dome(ru
     assert _published(p)["relative_error"] < 0.05  # published only (8 s)
 
 
+def test_a_design_trial_that_cannot_be_folded_is_rejected_not_fatal(run_mod, monkeypatch):
+    """A trial whose rigid limit fails (here the search's second evaluation, made to fail)
+    gets a penalty residual: the trust region rejects the step and the design still reaches
+    the arch, listing the failed trial. A start that cannot be folded fails the run."""
+    import design
+
+    from barhinge.errors import BarhingeError
+
+    real, calls = design.forward, []
+
+    def second_fails(cp, acts, steps, jac):
+        calls.append(1)
+        if len(calls) == 2:
+            raise BarhingeError("step 2: locked (made to fail by the test)")
+        return real(cp, acts, steps, jac)
+
+    monkeypatch.setattr(design, "forward", second_fails)
+    res = design.design("miura_arc", 0.0, -0.6, quick=True, steps=6)
+    (failed,) = res["failed_trials"]  # where, and why
+    assert failed.startswith(" at [") and failed.endswith(
+        "]: step 2: locked (made to fail by the test)"
+    )
+    assert res["reached"] and res["relative_error"] <= 0.05
+
+    calls.clear()
+    calls.append(1)  # the start is now the second call
+    with pytest.raises(BarhingeError, match="made to fail"):
+        design.design("miura_arc", 0.0, -0.6, quick=True, steps=6)
+
+
 def test_compliant_actuators_converge_to_the_rigid_limit_for_incompatible_targets(run_mod):
     """Miura, kappa L = 1: no rigid fold meets the curved targets. With compliant actuators
     the rigid limit and the bar-and-hinge model minimise the same energy, and the distance
