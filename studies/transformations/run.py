@@ -567,14 +567,18 @@ def findings(ix: dict, s: dict, records: dict, conv: list, comp: list, place: li
     fam_last = [
         abs(r["KL2_bh"][-1]) for r in c_conv if r["pattern"] in MIURA_FAMILY and r["kappa_L"] != 0
     ]
-    every = "every cell" if len(c_conv) == len(c_ok) else f"{len(c_conv)} of the cells"
+    where = (
+        f"every cell that finished ({len(c_ok)} of {len(comp)}"
+        if len(c_conv) == len(c_ok)
+        else f"{len(c_conv)} of the {len(c_ok)} cells that finished (of {len(comp)}"
+    )
     out.append(
         "**Compliant actuators make both models answer the same question.** With the actuators "
         f"springs of {COMPLIANT_K:g} × the stiffest fold in both models, the bar-and-hinge model "
-        f"converges to the rigid limit in {every} that finished ({len(c_conv)} of {len(c_ok)}, "
-        f"{len(comp)} cells; the springs stretch {_range([r['misfit_deg'] for r in c_in])}° in "
-        f"the rigid limit): slopes {_range([r['slope'] for r in c_conv])}, largest fold-angle "
-        f"distance {_range(last)}° at r = {s['compliant_ratios'][-1]:g}."
+        f"converges to the rigid limit in {where}; the springs stretch "
+        f"{_range([r['misfit_deg'] for r in c_in])}° in the rigid limit): slopes "
+        f"{_range([r['slope'] for r in c_conv])}, largest fold-angle distance "
+        f"{_range(last)}° at r = {s['compliant_ratios'][-1]:g}."
         + (
             " The saddles of the held Miura family under curved targets vanish with it: "
             f"|K L²| ≤ {_f(max(fam_last), '.2g')} at that ratio. They came from the strained "
