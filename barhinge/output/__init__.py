@@ -21,21 +21,22 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
+#: public name -> the module that defines it
 _EXPORTS = {
-    "RunOutput": "run",
-    "write_results": "run",
-    "write_run": "run",
-    "MANIFEST": "folder",
-    "add_to_manifest": "folder",
-    "atomic_file": "folder",
-    "check_output_folder": "folder",
-    "read_manifest": "folder",
-    "result_folder": "folder",
-    "run_summary": "summary",
-    "step_table": "table",
+    "RunOutput": "barhinge.output.run",
+    "write_results": "barhinge.output.run",
+    "write_run": "barhinge.output.run",
+    "MANIFEST": "barhinge.output.folder",
+    "add_to_manifest": "barhinge.output.folder",
+    "atomic_file": "barhinge.output.folder",
+    "check_output_folder": "barhinge.output.folder",
+    "read_manifest": "barhinge.output.folder",
+    "result_folder": "barhinge.output.folder",
+    "run_summary": "barhinge.output.summary",
+    "step_table": "barhinge.output.table",
     "state_data": "barhinge.fields",
     "state_mesh": "barhinge.fields",
-    "write_pictures": "pictures",
+    "write_pictures": "barhinge.output.pictures",
 }
 
 __all__ = sorted(_EXPORTS)
@@ -43,7 +44,5 @@ __all__ = sorted(_EXPORTS)
 
 def __getattr__(name: str) -> Any:
     if name in _EXPORTS:
-        module = _EXPORTS[name]
-        full = module if module.startswith("barhinge.") else f"barhinge.output.{module}"
-        return getattr(importlib.import_module(full), name)
+        return getattr(importlib.import_module(_EXPORTS[name]), name)
     raise AttributeError(f"module 'barhinge.output' has no attribute {name!r}")
