@@ -544,27 +544,24 @@ def pieces_lines(r: dict, rows: list[dict], steps: int) -> list[str]:
 
 
 def ten_million_lines(big: dict | None, rows: list[dict], steps: int) -> list[str]:
-    """Extrapolate refactorisation time and memory to 10 M DOF from the largest measured sizes
-    (the full folds and, where given, the measured pieces of a larger sheet)."""
+    """Extrapolate refactorisation time and memory to 10 M DOF from the largest measured sizes:
+    the refactorisation from the full folds and, where given, the measured pieces of a larger
+    sheet; the memory from the full folds' own peaks only (a Newton iteration's pieces peak
+    lower than a whole fold, which also holds its path and its stability counts)."""
     quasi = [q for q in rows if q["material"] == "quasi-rigid"]
-    if len(quasi) + (big is not None) < 2:
+    if len(quasi) < 2:
         return []
-    # memory above the libraries' own (the smallest sheet's process) scales with the sheet
-    base = min(q["fold_peak_mb"] for q in quasi)
-    pts = [(q["dof"], q["refactorisation"], q["fold_peak_mb"]) for q in quasi]
+    times = [(q["dof"], q["refactorisation"]) for q in quasi]
     if big is not None and all(q["dof"] != big["dof"] for q in quasi):
-        # a fold's peak: the refactorisation's or the stability count's, the larger
-        peak = max(
-            big["peak_mb"], big.get("peak_stability_mb", 0.0), big.get("peak_iteration_mb", 0.0)
-        )
-        pts.append((big["dof"], big["fact"], peak))
-    pts = sorted(pts)[-2:]  # the two largest sheets
-    (d0, f0, m0), (d1, f1, m1) = pts
+        times.append((big["dof"], big["fact"]))
+    (d0, f0), (d1, f1) = sorted(times)[-2:]  # the two largest sheets
+    # memory above the libraries' own (the smallest sheet's fold) scales with the sheet
+    base = min(q["fold_peak_mb"] for q in quasi)
+    (e0, m0), (e1, m1) = sorted((q["dof"], q["fold_peak_mb"]) for q in quasi)[-2:]
     pf = float(np.log(f1 / f0) / np.log(d1 / d0))
-    pm = float(np.log((m1 - base) / max(m0 - base, 1.0)) / np.log(d1 / d0))
-    scale = TEN_MILLION / d1
-    fact10 = f1 * scale**pf
-    mem10 = base + (m1 - base) * scale**pm
+    pm = float(np.log((m1 - base) / max(m0 - base, 1.0)) / np.log(e1 / e0))
+    fact10 = f1 * (TEN_MILLION / d1) ** pf
+    mem10 = base + (m1 - base) * (TEN_MILLION / e1) ** pm
     cells = int(round(np.sqrt(TEN_MILLION / 24.0), -1))  # N5B8 Miura: about 24 n^2 DOF
     ram = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**20
     # an extrapolation from two sheets is rough: "fits" only with a fifth of the memory spare
@@ -582,9 +579,10 @@ def ten_million_lines(big: dict | None, rows: list[dict], steps: int) -> list[st
         "",
         "### A 10 M DOF sheet (estimate)",
         "",
-        f"Extrapolated from the two largest sheets measured above ({d0} and {d1} DOF): the "
-        f"refactorisation grows like DOF^{pf:.2f} and the fold's peak memory above the "
-        f"libraries' {base:.0f} MB like DOF^{pm:.2f}. A sheet of 10 M DOF (a Miura of about "
+        f"Extrapolated from the largest sheets measured above: the refactorisation grows like "
+        f"DOF^{pf:.2f} (from {d0} to {d1} DOF) and a fold's peak memory above the libraries' "
+        f"{base:.0f} MB like DOF^{pm:.2f} (the full folds of {e0} and {e1} DOF). A sheet of "
+        f"10 M DOF (a Miura of about "
         f"{cells} x {cells} cells) would need about {mem10 / 1024:.1f} GB and "
         f"{fact10 / 60:.0f} min per refactorisation, so {steps * fact10 / 3600:.1f} h for the "
         f"floor of a {steps}-step fold on one node of this kind. {fits}; {needs} needs "
