@@ -313,9 +313,9 @@ def plate_corner_energy(
 
 
 #: largest estimated relative error of a panel's condensed plate stiffness (``_condensed``);
-#: a panel whose condensation would exceed it is refused as a sliver (the estimate grows
-#: like height^-3: a quadrilateral 1e-4 as high as wide keeps ~5e-8 to 1e-7, depending on
-#: the CPU's rounding; 1e-5 high ~6e-6, refused)
+#: a panel whose condensation would exceed it is refused as a sliver (the error grows like
+#: height^-3: a quadrilateral 1e-4 as high as wide is estimated at ~5e-8 and measured at up
+#: to ~1e-7, the CPU's rounding setting the constant; 1e-5 high ~6e-6, refused)
 CONDENSATION_ERROR_MAX = 1e-6
 
 
