@@ -28,6 +28,12 @@ together.
 ``--publish`` writes the tables into docs/solver-performance.md (between the ``scaling``
 markers), using :func:`barhinge._publish.write_between`.
 
+``--threads N`` fixes the thread count of every library (``BARHINGE_THREADS=N``) in each
+size's process, fold and floor alike (default: this machine's cores): under the default
+``auto`` policy the fold would take the cores the load average leaves free when it starts,
+while a bare factorisation outside the solver keeps the library's own default, and the ratio
+of the two would move with the load the previous size left.
+
 ``--materials`` chooses the stiffness sets (``quasi-rigid``, ``compliant``: the sets of
 ``bench_solver.miura_scene``); ``--compliant-sizes`` the sizes of the compliant set (it is
 slower). Per row also: Newton iterations per step, seconds per iteration, the *floor* (one
@@ -294,14 +300,16 @@ def _time_v(stderr: str) -> dict:
     return out
 
 
-def _child(args: list[str]) -> dict:
-    """Run one size in a fresh process (under ``time -v`` where it exists), echoing its
-    per-step progress lines live; its row, with the whole-process figures."""
+def _child(args: list[str], threads: int) -> dict:
+    """Run one size in a fresh process (under ``time -v`` where it exists) with every
+    library on ``threads`` threads, echoing its per-step progress lines live; its row, with
+    the whole-process figures."""
     cmd = [sys.executable, __file__, *args]
     timer = shutil.which("time") or ("/usr/bin/time" if Path("/usr/bin/time").exists() else None)
     if timer is not None:
         cmd = [timer, "-v", *cmd]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    env = {**os.environ, "BARHINGE_THREADS": str(threads)}
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     assert proc.stderr is not None and proc.stdout is not None
     err = []
     for line in proc.stderr:
@@ -338,6 +346,9 @@ def fold_table(rows: list[dict], steps: int) -> list[str]:
     """Markdown rows of the full folds, both stiffness sets."""
     lines = [
         f"### Miura n x n folds, flat -> 60 deg in {steps} steps",
+        "",
+        _threads_line(rows),
+        "",
         "| n | stiffness set | DOF | iterations / step | factorisations: all (of them for "
         "the stability events) | floor: one "
         "refactorisation per step, s | fold wall s | wall / floor | s / iteration | shares: "
@@ -359,6 +370,18 @@ def fold_table(rows: list[dict], steps: int) -> list[str]:
             f"| {_steps(r.get('held_unstable'))} |"
         )
     return lines
+
+
+def _threads_line(rows: list[dict]) -> str:
+    """The thread count the rows ran on (``--threads``), fold and floor alike."""
+    counts = sorted({str(r.get("threads", "-")) for r in rows})
+    if len(counts) == 1:
+        return (
+            f"Every library ran on {counts[0]} thread(s) (`BARHINGE_THREADS={counts[0]}`), "
+            "in the fold and in its floor alike."
+        )
+    per = ", ".join(f"n = {r['n']} {r['material']}: {r.get('threads', '-')}" for r in rows)
+    return f"Threads of every library (`BARHINGE_THREADS`), fold and floor alike: {per}."
 
 
 def _steps(steps: list[int] | None) -> str:
@@ -597,7 +620,7 @@ def ten_million_lines(big: dict | None, rows: list[dict], steps: int) -> list[st
 
 #: what a kept row must hold to be published (rows of older versions of this script are
 #: folded again)
-ROW_KEYS = frozenset({"fold_peak_mb"})
+ROW_KEYS = frozenset({"fold_peak_mb", "threads"})
 
 
 def _row_complete(row: dict) -> bool:
@@ -649,13 +672,30 @@ def main() -> None:
     ap.add_argument("--rows", help="JSON file keeping every finished size's row (resumes)")
     ap.add_argument("--fresh", action="store_true", help="fold sizes kept in --rows again")
     ap.add_argument("--publish", action="store_true", help="write into docs/")
+    ap.add_argument(
+        "--threads",
+        type=int,
+        default=None,
+        help="threads of every library in each size's process (default: the machine's cores)",
+    )
     a = ap.parse_args()
-    if a.one is not None:
-        print(json.dumps(one(a.one, a.steps, a.material)))
+    if a.one is not None or a.one_pieces is not None:
+        from barhinge.linalg.threads import policy, sparse_solves
+
+        # the fixed count of the parent's BARHINGE_THREADS, for the fold's factorisations
+        # and the floor's alike
+        with sparse_solves():
+            row = one(a.one, a.steps, a.material) if a.one is not None else pieces(a.one_pieces)
+        row["threads"] = policy()
+        print(json.dumps(row))
         return
-    if a.one_pieces is not None:
-        print(json.dumps(pieces(a.one_pieces)))
-        return
+    threads_given = a.threads
+    if a.threads is None:
+        from barhinge.linalg.threads import cores
+
+        a.threads = cores()
+    if a.threads < 1:
+        raise SystemExit(f"--threads {a.threads}: expected a whole number >= 1")
 
     rows, failed = [], []
     kept = _load_rows(a.rows)
@@ -674,7 +714,9 @@ def main() -> None:
                     flush=True,
                 )
             try:
-                row = _child(["--one", str(n), "--steps", str(a.steps), "--material", mat])
+                row = _child(
+                    ["--one", str(n), "--steps", str(a.steps), "--material", mat], a.threads
+                )
             except RuntimeError as exc:  # the other sizes still run and are published
                 print(f"error: n = {n}, {mat}: {exc}", file=sys.stderr, flush=True)
                 failed.append(f"n = {n}, {mat}: {exc}")
@@ -686,7 +728,7 @@ def main() -> None:
     lines += exponent_lines(rows)
     lines += [f"\n**Not completed**: {f}" for f in failed]
     for n in a.pieces:
-        big = _child(["--one-pieces", str(n)])
+        big = _child(["--one-pieces", str(n)], a.threads)
         lines += pieces_lines(big, rows, a.steps) + ten_million_lines(big, rows, a.steps)
     if not a.pieces:
         lines += ten_million_lines(None, rows, a.steps)
@@ -703,6 +745,8 @@ def main() -> None:
             cmd += " --compliant-sizes " + " ".join(map(str, a.compliant_sizes))
         if a.pieces:
             cmd += " --pieces " + " ".join(map(str, a.pieces))
+        if threads_given is not None:
+            cmd += f" --threads {threads_given}"
         doc = HERE.parent / "docs" / "solver-performance.md"
         body = "\n".join([generated_stamp(cmd), "", *lines])
         write_between(doc, "<!-- scaling:start -->", "<!-- scaling:end -->", body)
