@@ -68,6 +68,9 @@ class Timer:
     n_accelerated: int = 0  # Newton corrections taken with their geodesic acceleration
     n_chord: int = 0  # chord corrections kept (solved with the increment's factorisation)
     n_chord_rejected: int = 0  # chord corrections tried and discarded for a Newton one
+    n_tangent: int = 0  # evaluations with the tangent (force and tangent assembled)
+    assembly_tangent: float = 0.0  # their seconds (part of ``assembly``)
+    n_solves: int = 0  # back-substitutions with a factorisation (GMRES solves: n_krylov)
 
     def as_dict(self) -> dict[str, float]:
         return dataclasses.asdict(self)
@@ -744,6 +747,7 @@ class BorderedSystem:
             assert self.direct is not None  # current_factored: kept by _keep
             out = self.direct.solve(rhs_x, rhs_c)
             self.timer.solve += time.perf_counter() - t0
+            self.timer.n_solves += 1
             return out
         if np.ndim(rhs_x) == 2:
             cols = [self.solve(rhs_x[:, j], rhs_c[:, j], rtol) for j in range(rhs_x.shape[1])]
@@ -757,6 +761,7 @@ class BorderedSystem:
             assert self.direct is not None  # kept by _factorize_current
             out = self.direct.solve(rhs_x, rhs_c)
             self.timer.solve += time.perf_counter() - t1
+            self.timer.n_solves += 1
         else:
             self._krylov_cost += dt
             out = kout

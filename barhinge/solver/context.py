@@ -153,7 +153,11 @@ class SolveContext:
                 Kl = self.follower.stiffness(self.model, X)
                 K = (ev.K - (0.5 * st.lam) * (Kl + Kl.T)).tocsr()
                 ev = dataclasses.replace(cast(Any, ev), K=K)  # the model's frozen dataclass
-        self.timer.assembly += time.perf_counter() - t0
+        dt = time.perf_counter() - t0
+        self.timer.assembly += dt
+        if tangent:
+            self.timer.n_tangent += 1
+            self.timer.assembly_tangent += dt
         r = np.asarray(ev.force, float).ravel() - st.lam * P
         mu_act = st.mu
         if self.k_act is not None:  # compliant: spring moments k (rho - target)

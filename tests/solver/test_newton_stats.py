@@ -5,6 +5,7 @@ progress callback; failed increments counted by wrapping the increment itself.""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import barhinge as bh
 import barhinge.solver.newton as newton
@@ -73,3 +74,59 @@ def test_arc_length_lists_iterations():
     nw = path.meta["newton"]
     assert nw["iterations"] == path.iterations[1:].tolist()
     assert nw["total_iterations"] == int(path.iterations.sum())
+
+
+def test_clock_counts_match_independent_counts(monkeypatch):
+    """The solver clock's counts (``FoldPath.meta["timing"]``, what benchmarks/bench_steps.py
+    reads) against counts made by wrapping the model and the factor: every evaluation of the
+    model with its tangent is one ``n_tangent`` and every one without it one
+    ``n_force_only``; every back-substitution with the factor one ``n_solves``; the seconds
+    of the tangent evaluations are a part of the assembly's."""
+    from barhinge.linalg.backends import _PardisoFactor
+
+    count = {"tangent": 0, "force": 0, "solve": 0}
+    orig_eval = BarHingeModel.evaluate
+    orig_solve = _PardisoFactor.solve
+
+    def evaluate(self, X, tangent=True):
+        count["tangent" if tangent else "force"] += 1
+        return orig_eval(self, X, tangent=tangent)
+
+    def solve(self, b):
+        count["solve"] += 1
+        return orig_solve(self, b)
+
+    scene = _scene()  # the model's plate calibration evaluates it too: built first
+    scene = scene.with_(options={**scene.options.__dict__, "linear_solver": "pardiso"})
+    monkeypatch.setattr(BarHingeModel, "evaluate", evaluate)
+    monkeypatch.setattr(_PardisoFactor, "solve", solve)
+    path = bh.solve(scene)
+    tm = path.meta["timing"]
+    assert path.converged
+    assert tm["n_tangent"] == count["tangent"] > 0
+    assert tm["n_force_only"] == count["force"] > 0
+    # the bordered solves of the saddle-point factor, one PARDISO solve each (the Schur
+    # complement of the actuators comes with the factorisation, not as solves)
+    assert tm["n_solves"] == count["solve"] > 0
+    assert 0.0 < tm["assembly_tangent"] <= tm["assembly"]
+
+
+def test_step_clock_benchmark_groups_add_up_to_the_fold():
+    """benchmarks/bench_steps.py: its groups of steps partition the schedule, and their
+    rows (differences of the clock read after each step) add up to the whole fold's clock,
+    whose factorisations are the per-step counts of ``meta["newton"]``."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+    import bench_steps
+
+    assert bench_steps.groups(50, [1, 5, 10]) == [(1, 1), (2, 5), (6, 10), (11, 50)]
+    assert bench_steps.groups(4, [1, 5, 10]) == [(1, 1), (2, 4)]
+    run = bench_steps.fold_steps(3, 4, "quasi-rigid")
+    rows = [bench_steps.group_row(run, a, b) for a, b in bench_steps.groups(4, [1, 2])]
+    last = run["snaps"][-1]
+    for key in ("wall", "factorize", "n_factorizations", "n_tangent", "n_solves"):
+        assert sum(r[key] for r in rows) == pytest.approx(last[key])
+    assert sum(r["share"] for r in rows) == pytest.approx(1.0)
+    assert all(r["per_step_refac"] > 0 for r in rows)

@@ -1,0 +1,208 @@
+"""Where a fold's time goes, step by step: the flat start against the steps after it.
+
+Run:  python benchmarks/bench_steps.py [--sizes 40 70] [--compliant-sizes 20] [--steps 50]
+      [--split 1 5 10] [--threads N] [--publish]
+
+Each size folds ``bench_solver.miura_scene`` (Miura n x n, N5B8, flat -> 60 deg in
+``--steps`` steps, actuators on the middle crease line) with the solver's clock read after
+every step. The steps are grouped at ``--split`` (default: step 1, steps 2-5, 6-10 and the
+rest), and per group the table gives the wall time and its share of the fold, the
+factorisations, tangent assemblies, force-only evaluations and back-substitutions, where
+their seconds went, and the wall time per step in *refactorisations*: the median of seven
+bare numeric refactorisations of the last tangent (``bench_solver.bare_factorisation``,
+the unit of the scaling table's floor, docs/solver-performance.md). A step whose cost is 1.0
+refactorisation would meet that floor.
+
+``--threads N`` fixes every library's thread count (``BARHINGE_THREADS``; default this
+machine's cores), in the fold and in its refactorisations alike. ``--publish`` writes the
+table into docs/solver-performance.md (between the ``steps`` markers).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+#: bare refactorisations of the last tangent whose median is the unit of the last column (more
+#: than the scaling table's three: a median of three moved by 40 % between runs at 40 x 40)
+REPEATS = 7
+#: the solver clock's parts, in the table's order: (Timer field, column name)
+PARTS = (
+    ("factorize", "factorisation"),
+    ("assembly_tangent", "tangent assembly"),
+    ("assembly_force", "force evaluations"),
+    ("solve", "back-substitutions"),
+    ("rest", "rest"),
+)
+
+
+def _snapshot(timer, t0: float) -> dict[str, float]:
+    """The solver clock's totals now (seconds and counts), with the wall time since ``t0``."""
+    d = dict(timer.as_dict())
+    d["wall"] = time.perf_counter() - t0
+    d["assembly_force"] = d["assembly"] - d["assembly_tangent"]
+    return d
+
+
+def fold_steps(n: int, steps: int, material: str) -> dict:
+    """Fold the n x n sheet; the solver clock after every step and the refactorisation."""
+    from bench_solver import bare_factorisation, miura_scene
+
+    from barhinge.linalg.threads import sparse_solves
+    from barhinge.solver.newton import _Driver
+
+    sc = miura_scene(n, 0.0, steps, material=material)
+    with sparse_solves():
+        t0 = time.perf_counter()
+        driver = _Driver(sc)
+        # the clock starts before the driver is made: step 1 carries its set-up (rest)
+        snaps = [{k: 0.0 for k in _snapshot(driver.ctx.timer, t0)}]
+
+        def progress(done: int, total: int, value: float) -> None:
+            snaps.append(_snapshot(driver.ctx.timer, t0))
+
+        path = driver.run_parameter(progress)
+        mu = -np.asarray(path.actuator_moments[-1])
+        refac, _ = bare_factorisation(
+            sc, path.X[-1], mu, path.meta["linear_solver"], repeat=REPEATS
+        )
+    if not path.converged or len(snaps) != steps + 1:
+        raise RuntimeError(f"the {n} x {n} fold stopped short: {path.meta.get('message')}")
+    return {
+        "n": n,
+        "material": material,
+        "dof": int(sc.model.n_dof),
+        "snaps": snaps,
+        "refactorisation": refac,
+        "steps": steps,
+    }
+
+
+def groups(steps: int, split: list[int]) -> list[tuple[int, int]]:
+    """Step ranges (first, last), 1-based and inclusive, cut after each step of ``split``."""
+    cuts = sorted({s for s in split if 0 < s < steps}) + [steps]
+    out, first = [], 1
+    for c in cuts:
+        out.append((first, c))
+        first = c + 1
+    return out
+
+
+def _range(a: int, b: int) -> str:
+    return str(a) if a == b else f"{a}-{b}"
+
+
+def group_row(run: dict, a: int, b: int) -> dict:
+    """The clock of steps a..b of one fold (differences of its snapshots)."""
+    s0, s1 = run["snaps"][a - 1], run["snaps"][b]
+    d = {k: s1[k] - s0[k] for k in s1}
+    d["rest"] = d["wall"] - d["factorize"] - d["assembly"] - d["solve"]
+    d["n_steps"] = b - a + 1
+    d["share"] = d["wall"] / run["snaps"][-1]["wall"]
+    d["per_step_refac"] = d["wall"] / d["n_steps"] / run["refactorisation"]
+    return d
+
+
+def table(runs: list[dict], split: list[int]) -> list[str]:
+    head = (
+        "| n | stiffness set | steps | wall s (share of the fold) | factorisations | "
+        "tangent assemblies | force evaluations | back-substitutions | "
+        "seconds: " + " / ".join(name for _, name in PARTS) + " | "
+        "a step, in refactorisations |"
+    )
+    lines = [head, "|" + "---|" * 10]
+    for run in runs:
+        for a, b in groups(run["steps"], split):
+            d = group_row(run, a, b)
+            secs = " / ".join(f"{d[k]:.2f}" for k, _ in PARTS)
+            lines.append(
+                f"| {run['n']} | {run['material']} | {_range(a, b)} | "
+                f"{d['wall']:.1f} ({100 * d['share']:.0f} %) | {int(d['n_factorizations'])} | "
+                f"{int(d['n_tangent'])} | {int(d['n_force_only'])} | {int(d['n_solves'])} | "
+                f"{secs} | {d['per_step_refac']:.2f} |"
+            )
+    return lines
+
+
+def cost_lines(runs: list[dict], split: list[int]) -> list[str]:
+    """One sentence per fold: what a step after the flat start costs, in refactorisations."""
+    out = []
+    for run in runs:
+        a, b = groups(run["steps"], split)[-1]
+        d = group_row(run, a, b)
+        per = run["refactorisation"] * d["n_steps"]
+        parts = ", ".join(f"{name} {d[k] / per:.2f}" for k, name in PARTS)
+        first = group_row(run, 1, a - 1) if a > 1 else None
+        lead = (
+            f"steps 1-{a - 1} took {100 * first['share']:.0f} % of the fold"
+            if first is not None
+            else "no flat-start group"
+        )
+        out.append(
+            f"- {run['material']}, n = {run['n']} ({run['dof']} DOF; refactorisation "
+            f"{run['refactorisation']:.3f} s): {lead}; a step of steps {a}-{b} costs "
+            f"{d['per_step_refac']:.2f} refactorisations ({parts}), with "
+            f"{d['n_factorizations'] / d['n_steps']:.2f} factorisations, "
+            f"{d['n_tangent'] / d['n_steps']:.2f} tangent assemblies, "
+            f"{d['n_force_only'] / d['n_steps']:.2f} force evaluations and "
+            f"{d['n_solves'] / d['n_steps']:.2f} back-substitutions per step."
+        )
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--sizes", type=int, nargs="*", default=[40, 70])
+    ap.add_argument("--compliant-sizes", type=int, nargs="*", default=[20])
+    ap.add_argument("--steps", type=int, default=50)
+    ap.add_argument("--split", type=int, nargs="*", default=[1, 5, 10])
+    ap.add_argument("--threads", type=int, default=os.cpu_count() or 1)
+    ap.add_argument("--publish", action="store_true", help="write into docs/")
+    args = ap.parse_args()
+    if args.threads < 1:
+        ap.error(f"--threads must be at least 1, got {args.threads}")
+    os.environ["BARHINGE_THREADS"] = str(args.threads)
+    runs = []
+    jobs = [(n, "quasi-rigid") for n in args.sizes]
+    jobs += [(n, "compliant") for n in args.compliant_sizes]
+    for n, material in jobs:
+        print(f"folding {n} x {n} ({material}) ...", file=sys.stderr, flush=True)
+        runs.append(fold_steps(n, args.steps, material))
+    title = (
+        f"### Miura n x n, flat -> 60 deg in {args.steps} steps: the clock step by step "
+        f"({args.threads} thread(s))"
+    )
+    body = [title, "", *table(runs, args.split), "", *cost_lines(runs, args.split)]
+    print("\n".join(body))
+    if args.publish:
+        from barhinge._publish import generated_stamp, write_between
+
+        cmd = "python benchmarks/bench_steps.py --publish"
+        for flag, value, default in (
+            ("--sizes", args.sizes, [40, 70]),
+            ("--compliant-sizes", args.compliant_sizes, [20]),
+            ("--steps", [args.steps], [50]),
+            ("--split", args.split, [1, 5, 10]),
+        ):
+            if value != default:
+                cmd += f" {flag} " + " ".join(str(v) for v in value)
+        doc = HERE.parent / "docs" / "solver-performance.md"
+        write_between(
+            doc,
+            "<!-- steps:start -->",
+            "<!-- steps:end -->",
+            "\n".join([generated_stamp(cmd), "", *body]),
+        )
+        print(f"wrote {doc}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
