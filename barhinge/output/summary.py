@@ -23,6 +23,7 @@ __all__ = [
     "energy_share_text",
     "flat_start_text",
     "run_summary",
+    "slowest_steps",
     "stop_reason",
     "summary_rows",
 ]
@@ -34,6 +35,26 @@ def stop_reason(path: FoldPath) -> str | None:
     if path.converged:
         return None
     return str(path.meta.get("stopped") or "not converged")
+
+
+#: steps named in a summary's ``slowest_steps``
+SLOWEST_STEPS = 3
+
+
+def slowest_steps(wall_time: np.ndarray, k: int = SLOWEST_STEPS) -> list[dict[str, float]]:
+    """The ``k`` longest steps of a solve from its per-state wall clock ``wall_time`` (s since
+    the solve started; state 0 first): each ``{"step": i, "wall_s": t, "share": t / total}``,
+    the longest first, where step ``i`` ends at state ``i``; ``share`` is of the whole
+    solve's time to its last state. Empty without a step or a finite clock."""
+    wall = np.asarray(wall_time, float)
+    if len(wall) < 2 or not np.all(np.isfinite(wall)) or wall[-1] <= 0.0:
+        return []
+    dt = np.diff(wall)
+    order = np.argsort(-dt, kind="stable")[:k]
+    return [
+        {"step": int(i + 1), "wall_s": float(dt[i]), "share": float(dt[i] / wall[-1])}
+        for i in order
+    ]
 
 
 def _finite(v: float) -> float | None:
@@ -72,6 +93,8 @@ def run_summary(path: FoldPath, scene: Any = None) -> dict[str, Any]:
         "n_dof": path.meta.get("n_dof"),
         "linear_solver": path.meta.get("linear_solver"),
         "wall_time_s": _finite(wall[last]) if path.n_states else 0.0,
+        # where the solve spent its time: the longest steps (leaving a flat start, often)
+        "slowest_steps": slowest_steps(wall),
         "newton_iterations": int(np.sum(iters)),
         "load_factor": float(lam[last]),
         "max_abs_fold_deg": float(np.abs(path.fold_angles_deg[last]).max(initial=0.0)),
@@ -194,6 +217,16 @@ def summary_rows(summary: dict[str, Any], path: FoldPath | None = None) -> list[
             rows.append(("chord corrections", str(nw["total_chord"])))
     if summary["wall_time_s"] is not None:
         rows.append(("wall time (s)", f"{summary['wall_time_s']:.2f}"))
+    slow = summary.get("slowest_steps") or []
+    if summary["model"] != "rigid" and len(slow) > 1:
+        rows.append(
+            (
+                "slowest steps",
+                ", ".join(
+                    f"{d['step']}: {d['wall_s']:.2f} s ({_percent(d['share'])})" for d in slow
+                ),
+            )
+        )
     if summary.get("linear_solver"):
         rows.append(("linear solver", str(summary["linear_solver"])))
     for k, v in summary["energy"].items():

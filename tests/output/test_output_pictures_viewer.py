@@ -147,3 +147,34 @@ def test_summary_reports_factorisations_per_step(solved, tmp_path):
     assert nw["total_factorizations"] == sum(nw["factorizations"]) >= len(nw["factorizations"])
     row = dict(summary_rows(run.summary))["factorisations (per step; failed increments)"]
     assert row.startswith(f"{nw['total_factorizations']} (")
+
+
+def test_summary_names_the_slowest_steps(solved, tmp_path):
+    """summary.json names the longest steps of the solve from the path's own per-state
+    clock (the differences of ``FoldPath.wall_time``), the longest first, and the printed
+    table lists them."""
+    scene, path = solved
+    run = write_run(path, scene, tmp_path / "out", pictures="none", viewer=False)
+    slow = run.summary["slowest_steps"]
+    dt = np.diff(np.asarray(path.wall_time))
+    assert [d["step"] for d in slow] == (np.argsort(-dt, kind="stable")[:3] + 1).tolist()
+    for d in slow:
+        assert d["wall_s"] == pytest.approx(dt[d["step"] - 1])
+        assert d["share"] == pytest.approx(dt[d["step"] - 1] / path.wall_time[-1])
+    assert [d["wall_s"] for d in slow] == sorted((d["wall_s"] for d in slow), reverse=True)
+    assert 0.0 < sum(d["share"] for d in slow) <= 1.0
+    row = dict(summary_rows(run.summary))["slowest steps"]
+    assert row.startswith(f"{slow[0]['step']}: ")
+
+
+def test_slowest_steps_of_a_clock_without_steps_are_none():
+    from barhinge.output.summary import slowest_steps
+
+    assert slowest_steps(np.array([0.5])) == []
+    assert slowest_steps(np.array([0.0, np.nan])) == []
+    assert slowest_steps(np.array([0.0, 1.0, 4.0, 4.5])) == [
+        {"step": 2, "wall_s": 3.0, "share": 3.0 / 4.5},
+        {"step": 1, "wall_s": 1.0, "share": 1.0 / 4.5},
+        {"step": 3, "wall_s": 0.5, "share": 0.5 / 4.5},
+    ]
+    assert [d["step"] for d in slowest_steps(np.array([0.0, 2.0, 4.0, 7.0]), k=2)] == [3, 1]
