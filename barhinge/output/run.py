@@ -3,10 +3,10 @@
 (:func:`write_results`).
 
 A run writes ``fold_path.npz`` (the path), ``summary.json`` (one summary), ``states.csv``
-(one step table), the fields (``fold_path.xdmf``/``.h5``, ``fold_path_bars.xdmf``/``.h5``,
-``fold_path_NNNN.vtu``), FOLD frames (``fold_path.fold``), the interactive viewer
-(``viewer.html``), the pictures and the manifest ``barhinge-run.json``; docs/outputs.md lists
-every file with its columns and units.
+(one step table), ``iterations.csv`` (the solver's iterate log), the fields
+(``fold_path.xdmf``/``.h5``, ``fold_path_bars.xdmf``/``.h5``, ``fold_path_NNNN.vtu``), FOLD
+frames (``fold_path.fold``), the interactive viewer (``viewer.html``), the pictures and the
+manifest ``barhinge-run.json``; docs/outputs.md lists every file with its columns and units.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from barhinge.errors import ConfigError
 from barhinge.fields import StateData, path_state_data, write_state_vtus, write_xdmf
 from barhinge.output.folder import MANIFEST, result_folder
 from barhinge.output.summary import run_summary, stop_reason, summary_rows
-from barhinge.output.table import step_table, write_step_table
+from barhinge.output.table import step_table, write_iterate_table, write_step_table
 from barhinge.results import FoldPath
 
 __all__ = ["PICTURES", "RunOutput", "picture_level", "write_results", "write_run"]
@@ -34,6 +34,8 @@ log = logging.getLogger(__name__)
 
 #: the files of one run that are not optional extras
 SUMMARY, STEPS = "summary.json", "states.csv"
+#: the solver's iterate log (bar-and-hinge solves; :mod:`barhinge.solver.trace`)
+ITERATIONS = "iterations.csv"
 #: the interactive viewer of a run (:mod:`barhinge.view`)
 VIEWER = "viewer.html"
 #: what ``pictures`` may ask for: no pictures, the PNGs and charts, or those and the GIF
@@ -138,6 +140,9 @@ def _write(
             log.warning("fields not written: %s", exc)
     rows = step_table(fold_path, model=model, pattern=cp, states=states)
     written["csv"] = write_step_table(out / STEPS, rows)
+    iterates = fold_path.meta.get("iterates")
+    if iterates:
+        written["iterations"] = write_iterate_table(out / ITERATIONS, iterates)
     try:
         marks = {"fixed": fixed, "loads": loads}
         written.update(_extras(fold_path, model, cp, out, name, vtu, states, pictures, marks))

@@ -17,7 +17,7 @@ from barhinge.analysis.curvature import fit_quadratic, reference_points
 from barhinge.fields import StateData, state_data
 from barhinge.results import FoldPath
 
-__all__ = ["COLUMNS", "actuator_columns", "step_table", "write_step_table"]
+__all__ = ["COLUMNS", "actuator_columns", "step_table", "write_iterate_table", "write_step_table"]
 
 #: the columns of every run, in order; the actuator columns (:func:`actuator_columns`)
 #: follow them
@@ -156,3 +156,25 @@ def write_step_table(path: str | Path, rows: list[dict[str, float]]) -> Path:
             w.writerow(["" if isinstance(v, float) and not np.isfinite(v) else repr(v)
                         for v in (r[k] for k in keys)])  # fmt: skip
     return path
+
+
+def write_iterate_table(path: str | Path, columns: dict[str, list[Any]]) -> Path:
+    """Write the solver's iterate log (``FoldPath.meta["iterates"]``,
+    :class:`barhinge.solver.trace.IterateLog`) as CSV, one row per iterate (a value not
+    known is an empty cell; floats with all their digits)."""
+    path = Path(path)
+    keys = list(columns)
+    n = len(columns[keys[0]]) if keys else 0
+    with path.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(keys)
+        for i in range(n):
+            w.writerow([_cell(columns[k][i]) for k in keys])
+    return path
+
+
+def _cell(v: Any) -> str:
+    """A CSV cell: empty for None and NaN, strings as they are, numbers with all digits."""
+    if v is None or (isinstance(v, float) and not np.isfinite(v)):
+        return ""
+    return v if isinstance(v, str) else repr(v)

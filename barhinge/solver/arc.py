@@ -63,7 +63,8 @@ def arc_increment(
     while True:
         rf = float(np.linalg.norm(e.r[free]))
         res.append(rf)
-        ctx.iterate(rf, new.lam)
+        kind = "predictor" if it == 1 else "newton"
+        ctx.iterate(rf, new.lam, correction=float(np.linalg.norm(dx)), kind=kind)
         if not np.isfinite(rf):
             raise IncrementFailed("non-finite residual", res)
         if it > 1 and conv.converged(e, new, dx, _arc_correction(ctx, e, uh, tan1)):
@@ -145,11 +146,13 @@ def land_displacement(
     dx = np.zeros(int(free.sum()))
     uh = np.zeros_like(dx)  # K^-1 P of the factorisation at hand (from the first correction)
     why = f"no convergence in {o.max_iter} iterations"
+    ctx.begin_landing(new.lam)
     for it in range(1, o.max_iter + 1):
         e = ctx.evaluate(new)
         rf = float(np.linalg.norm(e.r[free]))
         res.append(rf)
-        ctx.iterate(rf, new.lam)
+        moved = np.linalg.norm((new.x - st.x)[free] if it == 1 else dx)
+        ctx.iterate(rf, new.lam, correction=float(moved), kind="predictor" if it == 1 else "newton")
         if not np.isfinite(rf):
             why = "non-finite residual"
             break

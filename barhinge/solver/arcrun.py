@@ -242,6 +242,7 @@ def _land(
     up to ``st`` when all fail."""
     whys = []
     for start in (st, past):
+        d.ctx.begin_landing(lam)
         try:
             return d.increment(start, start.t, lam)
         except IncrementFailed as f:
@@ -251,6 +252,7 @@ def _land(
     halvings, whys_sub = 0, ""
     while halvings <= d.opts.max_cutbacks:
         to = lam if abs(lam - cur.lam) <= abs(h) else cur.lam + h
+        d.ctx.begin_landing(to)
         try:
             cur, e, res = d.increment(cur, cur.t, to)
         except IncrementFailed as f:

@@ -18,6 +18,7 @@ from barhinge.linalg.indices import pattern_positions
 from barhinge.solver.bordered import ActuatorTerms, BorderedSystem, Timer, actuator_terms
 from barhinge.solver.diagnose import check_finite_tangent
 from barhinge.solver.state import Evaluation, IncrementFailed, IterationStatus, State
+from barhinge.solver.trace import IterateLog
 from barhinge.solver_options import SolverOptions
 
 if TYPE_CHECKING:
@@ -78,6 +79,8 @@ class SolveContext:
         # (step, steps, value, length, failed) of the current increment, its iterates so far
         self._increment: tuple[int, int, float, float, int] = (0, 0, 0.0, 1.0, 0)
         self._n_iterate = 0
+        #: every iterate of the solve (``FoldPath.meta["iterates"]``)
+        self.log = IterateLog()
 
     def make_system(self) -> BorderedSystem:
         """The bordered system of this problem (after the scene checks)."""
@@ -122,16 +125,36 @@ class SolveContext:
         ``failed`` failed increments of the step."""
         self._increment = (step, steps, value, length, failed)
         self._n_iterate = 0
+        self.log.begin_increment()
 
-    def iterate(self, residual: float, value: float | None = None) -> None:
+    def begin_landing(self, value: float) -> None:
+        """A correction onto an arc-length stop starts (a load-factor or displacement stop
+        passed): a new increment of the current one's step, aiming at ``value`` (load
+        factor)."""
+        step, steps, _, length, failed = self._increment
+        self.begin_increment(step, steps, value, length, failed)
+
+    def iterate(
+        self,
+        residual: float,
+        value: float | None = None,
+        correction: float = float("nan"),
+        kind: str = "newton",
+    ) -> None:
         """Count one iterate of the current increment, whose free force residual norm is
         ``residual`` (``value``: its path parameter or load factor, if not the increment's
-        aim), and tell ``on_iteration``."""
+        aim; ``correction``: the norm of the free displacement change that made it, length;
+        ``kind``: what made it, :data:`barhinge.solver.trace.ITERATE_KINDS`), log it and
+        tell ``on_iteration``."""
         self.timer.n_iterations += 1
+        step, steps, aim, length, failed = self._increment
+        v = aim if value is None else float(value)
+        n_fact = self.timer.n_factorizations
+        self.log.add(step, self._n_iterate, v, length, residual, correction, kind, n_fact)
         if self.on_iteration is not None:
-            step, steps, aim, length, failed = self._increment
-            v = aim if value is None else float(value)
-            status = IterationStatus(step, steps, v, length, self._n_iterate, residual, failed)
+            status = IterationStatus(
+                step, steps, v, length, self._n_iterate, residual, failed, correction, kind
+            )
             self.on_iteration(status)
         self._n_iterate += 1
 

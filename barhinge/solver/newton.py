@@ -104,6 +104,7 @@ class _Driver:
         self.conv = Convergence(ctx)
         self.records: list[StepRecord] = []
         self.t_start = time.perf_counter()
+        ctx.log.t0 = self.t_start  # the iterate log's clock is the states' own
         self.work = WorkIntegrator(ctx.P, ctx.fixed)
         self._prev: State | None = None
         self._prev2: State | None = None
@@ -160,10 +161,12 @@ class _Driver:
         dx_last: np.ndarray | None = None
         n_iter = 0  # Newton corrections (each factorises)
         n_chord = 0  # chord corrections kept (solved with the increment's factorisation)
+        # what made the iterate, and the norm of its free displacement change (iterate log)
+        kind, moved = "predictor", float(np.linalg.norm((new.x - st.x)[free]))
         while True:
             rf = float(np.linalg.norm(e.r[free]))
             res.append(rf)
-            ctx.iterate(rf)
+            ctx.iterate(rf, correction=moved, kind=kind)
             if not np.isfinite(rf) or not np.all(np.isfinite(e.c)):
                 raise IncrementFailed("non-finite residual", res)
 
@@ -189,12 +192,14 @@ class _Driver:
                 new, e, dx_last, n_fact = self.damping.correction(new, e, res)
                 n_iter += n_fact
                 damped = self.damping.delta > 0.0
+                kind, moved = "damped", float(np.linalg.norm(dx_last))
                 continue
             if n_iter and self._chord_allowed(res):
                 chord = self._chord(new, e, chord_step[0] if chord_step else None)
                 if chord is not None:
                     new, e, dx_last = chord
                     n_chord += 1
+                    kind, moved = "chord", float(np.linalg.norm(dx_last))
                     continue
             # the first correction always factorises: the predictor's bar forces change the
             # tangent too much for the previous factorisation to precondition it
@@ -202,11 +207,15 @@ class _Driver:
             n_iter += 1
             rtol = self.conv.forcing(e, new, rf)
             dx, dmu = self.system.solve(-e.r[free], -e.c, rtol=rtol)
+            kind = "newton"
             if self._accelerate(res):
+                n_acc = ctx.timer.n_accelerated
                 dx, dmu = self._accelerated(new, e, dx, dmu, rtol)
+                kind = "accelerated" if ctx.timer.n_accelerated > n_acc else kind
             light = self._expects_convergence(res) or self._chord_next(res)
             new, e, alpha = self.conv.line_search(new, e, dx, dmu, light)
             dx_last = alpha * dx
+            moved = float(np.linalg.norm(dx_last))
 
     def _off_flat(self) -> bool:
         """Whether the path leaves a flat start under fold-angle or displacement control

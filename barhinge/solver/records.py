@@ -106,6 +106,8 @@ def build_path(
         "flat_start": flat_start,
         "branch_events": branch_events,
         "newton": newton_summary(records, step_stats),
+        # every iterate of every increment, failed ones included (barhinge.solver.trace)
+        "iterates": ctx.log.columns(),
     }
     imperfection = getattr(ctx.model, "meta", {}).get("imperfection")
     if imperfection is not None:  # the model is stress-free in a buckling-mode shape

@@ -117,6 +117,12 @@ class IterationStatus:
     failed : int
         Increments of this step that failed so far (each redone shorter, or once at the
         same length from the tangent predictor).
+    correction : float
+        Norm of the free displacement change that made the iterate (from the last
+        converged state for the predictor), length; NaN where not known.
+    kind : str
+        What made the iterate (:data:`barhinge.solver.trace.ITERATE_KINDS`): "predictor",
+        "newton", "accelerated", "chord" or "damped".
     """
 
     step: int
@@ -126,3 +132,5 @@ class IterationStatus:
     iteration: int
     residual: float
     failed: int
+    correction: float = float("nan")
+    kind: str = "newton"
