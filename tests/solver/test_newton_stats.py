@@ -130,3 +130,27 @@ def test_step_clock_benchmark_groups_add_up_to_the_fold():
         assert sum(r[key] for r in rows) == pytest.approx(last[key])
     assert sum(r["share"] for r in rows) == pytest.approx(1.0)
     assert all(r["per_step_refac"] > 0 for r in rows)
+    # the corrections by kind (the iterate log) add up over the groups, and every Newton,
+    # accelerated or damped correction is one of the group's factorisations at least
+    log = run["iterates"]
+    counts = [bench_steps.correction_counts(run, a, b) for a, b in bench_steps.groups(4, [1, 2])]
+    for kind in bench_steps.CORRECTIONS:
+        assert sum(c[kind] for c in counts) == log["kind"].count(kind)
+    for c, r in zip(counts, rows, strict=True):
+        assert c["newton"] + c["accelerated"] + c["damped"] <= r["n_factorizations"]
+    assert sum(c["failed"] for c in counts) == 0 == sum(run["failed"])
+    # with one increment a step, the residual histories the driver recorded for the states
+    # say which corrections raised the residual
+    assert run["increments"] == [1] * 4
+    rose = sum(int(np.sum(np.diff(h) > 0)) for h in run["residuals"])
+    assert sum(c["rose"] for c in counts) == rose > 0
+    assert bench_steps.hardest_step(run, 4) == int(np.argmax(run["factorizations"])) + 1
+    # the unit of the last column: the fold's own factorisations (the steps with exactly one,
+    # by the driver's own count, step 1 with state 0's; else every step's seconds per
+    # factorisation)
+    per_step = [run["factorizations"][0] + 1, *run["factorizations"][1:]]
+    samples = run["fold_factorisation_samples"]
+    assert len(samples) == (per_step.count(1) or sum(f > 0 for f in per_step))
+    assert run["fold_factorisation"] == pytest.approx(float(np.median(samples)))
+    total = last["factorize"]
+    assert min(samples) > 0.0 and max(samples) <= total
