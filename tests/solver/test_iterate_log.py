@@ -14,7 +14,6 @@ import pytest
 import barhinge as bh
 import barhinge.solver.newton as newton
 from barhinge.errors import ConvergenceError
-from barhinge.families import miura_line_creases
 from barhinge.model.model import BarHingeModel
 from barhinge.output.run import ITERATIONS, write_run
 from barhinge.scene import Scene
@@ -23,24 +22,13 @@ from barhinge.solver.damping import Damping
 from barhinge.solver.trace import ITERATE_COLUMNS, ITERATE_KINDS
 
 
-def _scene(steps: int = 6) -> Scene:
-    """A 3 x 3 Miura sheet folded from flat in a few long steps: cut-backs (failed
-    increments), damped, chord and accelerated corrections all occur."""
-    cp0 = bh.families.miura(3, 3, alpha=60.0, fold=0.0)
-    cp1 = bh.families.miura(3, 3, alpha=60.0, fold=60.0)
-    edges = miura_line_creases(cp0)
-    model = BarHingeModel.from_pattern(cp0, "N5B8", fold_stiffness=0.1, bar_EA=1e3)
-    acts = bh.Actuators(edges=edges, targets_deg=np.asarray(cp1.fold_angles)[edges])
-    return Scene(model, actuators=acts, steps=steps, options={"max_iter": 8})
-
-
 def _by_increment(log: dict, key: str) -> list[list]:
     """The column ``key`` of the log, split into its increments."""
     inc = np.asarray(log["increment"])
     return [list(np.asarray(log[key], dtype=object)[inc == i]) for i in np.unique(inc)]
 
 
-def test_iterate_log_against_independent_records(monkeypatch):
+def test_iterate_log_against_independent_records(monkeypatch, flat_miura):
     residuals: list[list[float]] = []  # every increment's residual history, failed ones too
     moves: list[tuple[str, float]] = []  # (kind, norm) of every correction taken
     orig_inc = newton._Driver.increment
@@ -77,7 +65,7 @@ def test_iterate_log_against_independent_records(monkeypatch):
     monkeypatch.setattr(Convergence, "line_search", line_search)
     monkeypatch.setattr(newton._Driver, "_chord", chord)
     monkeypatch.setattr(Damping, "correction", damped)
-    path = bh.solve(_scene())
+    path = bh.solve(flat_miura())
     log = path.meta["iterates"]
     timing = path.meta["timing"]
 
@@ -136,11 +124,11 @@ def test_arc_length_log():
     assert all(c > 0 for c in log["correction"])
 
 
-def test_a_failed_solve_keeps_its_iterates():
+def test_a_failed_solve_keeps_its_iterates(flat_miura):
     """Three steps are too long for the flat start: the error's partial path carries the log
     of every failed increment (what a user reads to see how Newton failed)."""
     with pytest.raises(ConvergenceError) as err:
-        bh.solve(_scene(steps=3))
+        bh.solve(flat_miura(3))
     part = err.value.last_state
     log = part.meta["iterates"]
     assert len(log["step"]) == part.meta["timing"]["n_iterations"] > 0
@@ -150,8 +138,8 @@ def test_a_failed_solve_keeps_its_iterates():
     assert all(k[0] == "predictor" for k in _by_increment(log, "kind"))
 
 
-def test_iterations_csv_is_the_log(tmp_path):
-    scene = _scene()
+def test_iterations_csv_is_the_log(tmp_path, flat_miura):
+    scene = flat_miura()
     path = bh.solve(scene)
     run = write_run(path, scene, tmp_path / "run", pictures="none", viewer=False)
     assert tmp_path / "run" / ITERATIONS in run.files

@@ -9,24 +9,12 @@ import pytest
 
 import barhinge as bh
 import barhinge.solver.newton as newton
-from barhinge.families import miura_line_creases
 from barhinge.model.model import BarHingeModel
 from barhinge.scene import Scene
 from barhinge.solver.bordered import BorderedSystem
 
 
-def _scene(steps: int = 6) -> Scene:
-    cp0 = bh.families.miura(3, 3, alpha=60.0, fold=0.0)
-    cp1 = bh.families.miura(3, 3, alpha=60.0, fold=60.0)
-    edges = miura_line_creases(cp0)
-    model = BarHingeModel.from_pattern(cp0, "N5B8", fold_stiffness=0.1, bar_EA=1e3)
-    acts = bh.Actuators(edges=edges, targets_deg=np.asarray(cp1.fold_angles)[edges])
-    # few long steps from flat: the first increments are cut back (max_iter 8: with the
-    # softer plate-calibrated panels 6 iterations no longer converge at any step size)
-    return Scene(model, actuators=acts, steps=steps, options={"max_iter": 8})
-
-
-def test_newton_stats_match_independent_counts(monkeypatch):
+def test_newton_stats_match_independent_counts(monkeypatch, flat_miura):
     count = {"fact": 0, "failed": 0}
     orig_fact = BorderedSystem._factorize_current
     orig_inc = newton._Driver.increment
@@ -45,7 +33,7 @@ def test_newton_stats_match_independent_counts(monkeypatch):
     monkeypatch.setattr(BorderedSystem, "_factorize_current", fact)
     monkeypatch.setattr(newton._Driver, "increment", inc)
     at_step = []
-    path = bh.solve(_scene(), progress=lambda done, total, t: at_step.append(count["fact"]))
+    path = bh.solve(flat_miura(), progress=lambda done, total, t: at_step.append(count["fact"]))
     nw = path.meta["newton"]
     steps = path.meta["steps"]
     assert nw["iterations"] == path.iterations[1:].tolist()
@@ -76,7 +64,7 @@ def test_arc_length_lists_iterations():
     assert nw["total_iterations"] == int(path.iterations.sum())
 
 
-def test_clock_counts_match_independent_counts(monkeypatch):
+def test_clock_counts_match_independent_counts(monkeypatch, flat_miura):
     """The solver clock's counts (``FoldPath.meta["timing"]``, what benchmarks/bench_steps.py
     reads) against counts made by wrapping the model and the factor: every evaluation of the
     model with its tangent is one ``n_tangent`` and every one without it one
@@ -96,7 +84,7 @@ def test_clock_counts_match_independent_counts(monkeypatch):
         count["solve"] += 1
         return orig_solve(self, b)
 
-    scene = _scene()  # the model's plate calibration evaluates it too: built first
+    scene = flat_miura()  # the model's plate calibration evaluates it too: built first
     scene = scene.with_(options={**scene.options.__dict__, "linear_solver": "pardiso"})
     monkeypatch.setattr(BarHingeModel, "evaluate", evaluate)
     monkeypatch.setattr(_PardisoFactor, "solve", solve)
