@@ -30,6 +30,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from barhinge.linalg.indices import index_dtype, pattern_positions
+from barhinge.linalg.threads import parallel_map
 
 __all__ = ["Assembler", "PackedRows", "element_dofs"]
 
@@ -87,6 +88,12 @@ def _block_pattern(
 #: component ``3 j + i`` of a 3x3 block for its component ``3 i + j`` (the transpose)
 _TRANSPOSED = np.array([0, 3, 6, 1, 4, 7, 2, 5, 8])
 
+#: instances of a chunk from which its nine components are summed side by side on the
+#: worker threads (below, the threads' hand-over costs more than the sums)
+PARALLEL_INSTANCES = 1 << 14
+#: tangent values gathered from the block sums per part, the parts side by side on the
+#: worker threads (:meth:`Assembler.matrix_from_sums`)
+GATHER_PART = 1 << 18
 #: element-vector entries summed at a time by :meth:`Assembler.force`
 FORCE_CHUNK = 1 << 20
 #: tangent entries filled at a time by :meth:`Assembler.matrix_from_sums` (whole node rows)
@@ -141,10 +148,24 @@ def _chunk_summation(
     return _Chunk(start, stop, out, summation(~swapped), summation(swapped))
 
 
+def _parts(start: int, stop: int, size: int) -> list[slice]:
+    """``[start, stop)`` in slices of ``size``."""
+    return [slice(p, min(p + size, stop)) for p in range(start, stop, size)]
+
+
 def _add_chunk(sums: np.ndarray, V: np.ndarray, chunk: _Chunk) -> None:
-    """Add the ``(9, instances)`` values ``V`` of one chunk into the block sums."""
-    for c in range(9):
+    """Add the ``(9, instances)`` values ``V`` of one chunk into the block sums: the nine
+    components side by side on the worker threads where the chunk is large (each writes
+    its own row of ``sums``; the sums do not depend on the number of threads)."""
+
+    def component(c: int) -> None:
         sums[c, chunk.out] += chunk.direct @ V[c] + chunk.swapped @ V[_TRANSPOSED[c]]
+
+    if V.shape[1] >= PARALLEL_INSTANCES:
+        parallel_map(component, range(9))
+    else:
+        for c in range(9):
+            component(c)
 
 
 class PackedRows:
@@ -459,12 +480,23 @@ class Assembler:
         flat = data[: 9 * nblk]
         ip = self._blocks_indptr
         a1 = self.n_nodes
+        read = np.empty(min(SUMS_FILL_CHUNK + 9 * int(np.diff(ip).max(initial=0)), self.nnz))
+
+        def gather(part: slice) -> None:
+            np.take(flat, self._gather[part], out=read[part.start - p0 : part.stop - p0])
+
+        def write(part: slice) -> None:
+            data[part] = read[part.start - p0 : part.stop - p0]
+
         while a1 > 0:
             # node rows [a0, a1): their entries [9 ip[a0], 9 ip[a1])
             a0 = int(np.searchsorted(ip, ip[a1] - SUMS_FILL_CHUNK // 9, side="left"))
             a0 = max(min(a0, a1 - 1), 0)
             p0, p1 = 9 * int(ip[a0]), 9 * int(ip[a1])
-            data[p0:p1] = flat[self._gather[p0:p1]]  # read (a copy) before the write
+            # read every value of the rows (in parts, side by side), then write them
+            parts = _parts(p0, p1, GATHER_PART)
+            parallel_map(gather, parts)
+            parallel_map(write, parts)
             a1 = a0
         K = sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n_dof, self.n_dof))
         K.has_sorted_indices = True

@@ -32,7 +32,7 @@ from barhinge.analysis.curvature import (
 )
 from barhinge.analysis.forces import panel_membrane_resultants
 from barhinge.errors import ConfigError
-from barhinge.linalg.threads import file_threads
+from barhinge.linalg.threads import worker_threads
 from barhinge.results import FoldPath
 
 __all__ = [
@@ -335,11 +335,11 @@ def write_state_vtu(path: str | Path, X: np.ndarray | None = None, **kwargs: Any
 def write_state_vtus(paths: Sequence[str | Path], states: Sequence[StateData]) -> list[Path]:
     """Write ``states[i]`` to ``paths[i]`` (``.vtu``), several files at a time: meshio's
     zlib compression, most of a file's time, releases the GIL, so the files are written by
-    :func:`barhinge.linalg.threads.file_threads` threads.
+    :func:`barhinge.linalg.threads.worker_threads` threads.
     An error in any file is raised after the others are finished."""
     if len(paths) != len(states):
         raise ValueError(f"{len(paths)} paths for {len(states)} states")
-    workers = min(len(paths), file_threads())
+    workers = min(len(paths), worker_threads())
     if workers <= 1:
         return [write_state_vtu(p, data=d) for p, d in zip(paths, states, strict=True)]
     with ThreadPoolExecutor(max_workers=workers) as pool:

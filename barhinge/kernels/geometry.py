@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from barhinge._typing import StrainMeasure
+from barhinge.linalg.threads import parallel_map
 
 __all__ = [
     "bar_lengths",
@@ -48,6 +49,7 @@ __all__ = [
     "bar_strain_derivatives",
     "bar_strain_gradient",
     "bar_strain_hessian",
+    "element_passes",
     "hinge_angle",
     "hinge_angle_gradient",
     "hinge_angle_gradient_t",
@@ -55,6 +57,15 @@ __all__ = [
     "hinge_angle_hessian_packed",
     "hinge_energy_hessian_packed",
 ]
+
+#: hinges per pass of the Hessian kernel (:func:`hinge_energy_hessian_packed`) and of the
+#: force-only gradient kernel (:func:`hinge_angle_gradient_t`): each pass's working vectors
+#: stay in cache, and the passes run side by side on the worker threads. The passes are
+#: the same whatever the number of threads, so are the results to the last bit.
+HESSIAN_CHUNK = 8192
+GRADIENT_CHUNK = 16384
+#: bars per pass of the assembly's bar kernel (:mod:`barhinge.model.model`)
+BAR_CHUNK = 16384
 
 
 # ---------------------------------------------------------------------------------- bars
@@ -222,16 +233,27 @@ def _hinge_grad_t(XT: np.ndarray, hinges: np.ndarray):
 
 
 def hinge_angle_gradient_t(
-    X: np.ndarray, hinges: np.ndarray, chunk: int = 16384
+    X: np.ndarray, hinges: np.ndarray, chunk: int | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Component-major ``(rho (nh,), grad (12, nh))`` (the force-only fast path)."""
+    """Component-major ``(rho (nh,), grad (12, nh))`` (the force-only fast path), in passes
+    of ``chunk`` hinges (``GRADIENT_CHUNK`` by default)."""
+    chunk = GRADIENT_CHUNK if chunk is None else chunk
     XT = np.ascontiguousarray(X.T)
     nh = len(hinges)
     rho, grad = np.empty(nh), np.empty((12, nh))
-    for s0 in range(0, nh, chunk):
-        sl = slice(s0, min(s0 + chunk, nh))
+
+    def one(sl: slice) -> None:
         rho[sl], grad[:, sl], _ = _hinge_grad_t(XT, hinges[sl])
+
+    parallel_map(one, element_passes(nh, chunk))
     return rho, grad
+
+
+def element_passes(n: int, chunk: int) -> list[slice]:
+    """The slices of ``n`` elements ``chunk`` at a time: a kernel's passes, run side by
+    side on :func:`barhinge.linalg.threads.worker_threads` threads (each writes its own
+    elements only, so the results do not depend on the number of threads)."""
+    return [slice(s0, min(s0 + chunk, n)) for s0 in range(0, n, chunk)]
 
 
 def _hinge_hessian_packed_t(
@@ -386,7 +408,7 @@ def hinge_energy_hessian_packed(
     hinges: np.ndarray,
     law,
     out: Any = None,
-    chunk: int = 8192,
+    chunk: int | None = None,
     start: int = 0,
     XT: np.ndarray | None = None,
 ):
@@ -399,8 +421,9 @@ def hinge_energy_hessian_packed(
     out : optional (78, nh) float array to write the packed Hessian into, or any object
         whose ``out[p]`` is a writable ``(nh,)`` row and ``out[:, sl]`` those rows of the
         hinges ``sl`` (the assembler's :class:`~barhinge.assembly.PackedRows`)
-    chunk : hinges per pass (keeps the working vectors in cache; a loop over chunks, not
-        elements)
+    chunk : hinges per pass (``HESSIAN_CHUNK`` by default: keeps the working vectors in
+        cache; the passes run side by side on the worker threads, and ``law`` is called
+        from them)
     start : the position of ``hinges[0]`` among the model's hinges (the law's slices are
         shifted by it: ``hinges`` may be a part of the model's)
     XT : optional ``X.T`` as a C-contiguous (3, n_nodes) array (saves the copy of a caller
@@ -412,13 +435,16 @@ def hinge_energy_hessian_packed(
     energy Hessian ``M d2rho/dX2 + Kt grad grad^T`` (78, nh) in ``TRIU12`` order.
     """
     nh = len(hinges)
+    chunk = HESSIAN_CHUNK if chunk is None else chunk
     XT = np.ascontiguousarray(X.T) if XT is None else XT
     Hp = np.empty((78, nh)) if out is None else out
     grad = np.empty((12, nh))
     rho, M, Kt, W = (np.empty(nh) for _ in range(4))
-    for s0 in range(0, nh, chunk):
-        sl = slice(s0, min(s0 + chunk, nh))
+
+    def one(sl: slice) -> None:
         in_model = slice(start + sl.start, start + sl.stop)
         r, g, _, (m, k, e) = _hinge_hessian_packed_t(XT, hinges[sl], law, in_model, Hp[:, sl])
         rho[sl], grad[:, sl], M[sl], Kt[sl], W[sl] = r, g, m, k, e
+
+    parallel_map(one, element_passes(nh, chunk))
     return rho, M, Kt, W, grad, Hp

@@ -11,6 +11,11 @@ Two kinds of work need different threading:
   cores. :func:`sparse_solves` limits MKL to the cores the load average leaves free (at
   least one) and other BLAS libraries to one thread.
 
+barhinge's own work runs on :func:`worker_threads` threads: the element kernels of a
+tangent or force evaluation, chunk by chunk (numpy releases Python's lock inside each
+vector operation), and the result files (zlib compression releases it too).
+:func:`parallel_map` runs such work on one pool per process, in the order given.
+
 The policy is set by the environment variable ``BARHINGE_THREADS``:
 
 ``auto`` (default)
@@ -30,7 +35,9 @@ from __future__ import annotations
 import contextlib
 import functools
 import os
-from collections.abc import Callable, Iterator
+import threading
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any, TypeVar
 
 from threadpoolctl import ThreadpoolController, threadpool_limits
@@ -39,15 +46,18 @@ from barhinge.errors import ConfigError
 
 __all__ = [
     "dense_calls",
-    "file_threads",
     "free_cores",
+    "parallel_map",
     "policy",
     "single_threaded_dense",
     "sparse_solves",
     "threads_for_sparse",
+    "worker_threads",
 ]
 
 F = TypeVar("F", bound=Callable[..., Any])
+T = TypeVar("T")
+R = TypeVar("R")
 
 ENV = "BARHINGE_THREADS"
 
@@ -74,15 +84,55 @@ def cores() -> int:
         return os.cpu_count() or 1
 
 
-def file_threads() -> int:
-    """Threads that write result files side by side: the count of ``BARHINGE_THREADS`` when
-    it is a number, one under ``off``, else the process's cores (zlib compression, most of
-    a field file's time, releases the GIL; the load a finished solve left on the load
-    average is no reason to write one file at a time)."""
+def worker_threads() -> int:
+    """Threads barhinge runs its own work on (element kernels, result files): the count of
+    ``BARHINGE_THREADS`` when it is a number, one under ``off``, else the process's cores
+    (not the free ones: the load average a solve's own factorisations leave on the machine
+    is no reason to evaluate its next tangent on one thread)."""
     p = policy()
     if isinstance(p, int):
         return p
     return 1 if p == "off" else cores()
+
+
+#: (process id, threads, pool) of the pool :func:`parallel_map` runs on
+_pool: tuple[int, int, ThreadPoolExecutor] | None = None
+_pool_lock = threading.Lock()
+_in_worker = threading.local()
+
+
+def _mark_worker() -> None:
+    _in_worker.flag = True
+
+
+def _worker_pool(n: int) -> ThreadPoolExecutor:
+    """The process's pool of ``n`` threads (made again after a fork or a new count)."""
+    global _pool
+    with _pool_lock:
+        pid = os.getpid()
+        if _pool is None or _pool[0] != pid or _pool[1] != n:
+            if _pool is not None and _pool[0] == pid:
+                _pool[2].shutdown(wait=False)
+            pool = ThreadPoolExecutor(n, "barhinge-worker", initializer=_mark_worker)
+            _pool = (pid, n, pool)
+        return _pool[2]
+
+
+def parallel_map(fn: Callable[[T], R], items: Iterable[T]) -> list[R]:
+    """``[fn(item) for item in items]`` on :func:`worker_threads` threads, results in the
+    order of ``items``; serial with one thread, one item, or when called from one of the
+    pool's own threads (no nested wait on the same pool). ``fn`` must write only what no
+    other item writes. The first error raised by any item is raised after all have run."""
+    items = list(items)
+    n = worker_threads()
+    if n <= 1 or len(items) < 2 or getattr(_in_worker, "flag", False):
+        return [fn(item) for item in items]
+    futures = [_worker_pool(n).submit(fn, item) for item in items]
+    errors = [f.exception() for f in futures]
+    for err in errors:
+        if err is not None:
+            raise err
+    return [f.result() for f in futures]
 
 
 def free_cores() -> int:

@@ -25,15 +25,18 @@ from barhinge._typing import SCHEMES, Scheme, StrainMeasure
 from barhinge.assembly import Assembler, PackedRows
 from barhinge.errors import ConfigError
 from barhinge.kernels.geometry import (
+    BAR_CHUNK,
     bar_strain,
     bar_strain_gradient,
     bar_strain_hessian,
+    element_passes,
     hinge_angle,
     hinge_angle_gradient_t,
     hinge_energy_hessian_packed,
 )
 from barhinge.kernels.laws import bar_linear, hinge_linear, hinge_penetration
 from barhinge.linalg.heap import release_free_heap
+from barhinge.linalg.threads import parallel_map
 from barhinge.model.calibrate import (
     BAR_CALIBRATIONS,
     BEND_COEFFICIENT_F17,
@@ -152,6 +155,31 @@ def _ro(a: np.ndarray) -> np.ndarray:
     a = np.ascontiguousarray(a)
     a.setflags(write=False)
     return a
+
+
+def _bar_hessian_rows(
+    rows: PackedRows,
+    d: np.ndarray,
+    eps: np.ndarray,
+    S: np.ndarray,
+    dS: np.ndarray,
+    L0: np.ndarray,
+    strain: StrainMeasure,
+) -> None:
+    """Write the packed upper triangles of the bars' energy Hessians
+    ``[[k, -k], [-k, k]]``, ``k = S' d d^T + S B`` (``S`` the axial force conjugate to the
+    strain, ``S'`` its derivative, ``d`` the strain gradient, ``B`` its Hessian), into
+    ``rows``: the 6 distinct entries of the symmetric 3x3 ``k``, then the other 15 rows as
+    signed copies."""
+    dT = np.ascontiguousarray(d.T)
+    B = bar_strain_hessian(d, eps, L0, strain)
+    for q, (a, b) in enumerate(_SYM3):
+        row = rows[_BAR_FIRST[q]]
+        np.multiply(dS * dT[a], dT[b], out=row)
+        row += S * B[:, a, b]
+    for p_, (q, sgn) in enumerate(zip(_BAR_Q, _BAR_SIGN, strict=True)):
+        if p_ != _BAR_FIRST[q]:
+            np.multiply(rows[_BAR_FIRST[q]], sgn, out=rows[p_])
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -616,17 +644,15 @@ class BarHingeModel:
                 if group == 0:
                     # bar: [[k, -k], [-k, k]] with k = S'' d d^T + S B, packed upper
                     # triangle of 6x6; the 6 distinct entries of the symmetric 3x3 k. B and
-                    # d's rows are made for this chunk only (not held for all bars)
-                    dT = np.ascontiguousarray(d[sl].T)
-                    B = bar_strain_hessian(d[sl], eps[sl], L0[sl], strain)
-                    for q, (a, b) in enumerate(_SYM3):
-                        row = rows[_BAR_FIRST[q]]
-                        np.multiply(dS[sl] * dT[a], dT[b], out=row)
-                        row += S[sl] * B[:, a, b]
-                    for p_, (q, sgn) in enumerate(zip(_BAR_Q, _BAR_SIGN, strict=True)):
-                        if p_ != _BAR_FIRST[q]:
-                            np.multiply(rows[_BAR_FIRST[q]], sgn, out=rows[p_])
-                    fb = dT * S[sl]
+                    # d's rows are made pass by pass (not held for all bars)
+                    def bar_pass(part: slice) -> None:
+                        own = slice(sl.start + part.start, sl.start + part.stop)
+                        _bar_hessian_rows(
+                            rows[:, part], d[own], eps[own], S[own], dS[own], L0[own], strain
+                        )
+
+                    parallel_map(bar_pass, element_passes(sl.stop - sl.start, BAR_CHUNK))
+                    fb = d[sl].T * S[sl]
                     asm.add_force(force, 0, sl, np.concatenate([-fb, fb]))
                 else:  # packed upper triangle (78, nh) of the hinge Hessian
                     out = hinge_energy_hessian_packed(

@@ -6,6 +6,8 @@ reading of what the BLAS libraries are set to)."""
 from __future__ import annotations
 
 import importlib
+import threading
+import time
 
 import pytest
 from threadpoolctl import threadpool_info
@@ -84,7 +86,7 @@ def test_field_files_are_written_by_the_policys_threads(monkeypatch, raw, want):
     monkeypatch.setenv(threads.ENV, raw)
     monkeypatch.setattr(threads, "cores", lambda: 5)
     monkeypatch.setattr(threads.os, "getloadavg", lambda: (40.0, 0.0, 0.0))
-    assert threads.file_threads() == want
+    assert threads.worker_threads() == want
 
 
 def test_public_calls_run_under_the_policy(monkeypatch):
@@ -104,3 +106,61 @@ def test_public_calls_run_under_the_policy(monkeypatch):
     bh.dof(bh.families.miura(2, 2))
     assert seen and all(set(s.values()) == {1} for s in seen)
     assert bh.dof.__name__ == "dof" and "Parameters" in (bh.dof.__doc__ or "")
+
+
+def test_parallel_map_runs_on_the_worker_threads_in_order(monkeypatch):
+    """Results come back in the order of the items, computed on the pool's own threads."""
+    monkeypatch.setenv(threads.ENV, "3")
+    seen: list[str] = []
+
+    def square(i: int) -> int:
+        seen.append(threading.current_thread().name)
+        time.sleep(0.001 * (7 - i))  # later items finish first
+        return i * i
+
+    assert threads.parallel_map(square, range(7)) == [i * i for i in range(7)]
+    assert all(name.startswith("barhinge-worker") for name in seen)
+
+
+@pytest.mark.parametrize("raw", ["1", "off"])
+def test_parallel_map_is_serial_on_one_thread(monkeypatch, raw):
+    monkeypatch.setenv(threads.ENV, raw)
+    seen: list[str] = []
+    out = threads.parallel_map(lambda i: seen.append(threading.current_thread().name) or i, [1, 2])
+    assert out == [1, 2]
+    assert seen == [threading.current_thread().name] * 2
+
+
+def test_parallel_map_raises_after_every_item_ran_and_does_not_nest(monkeypatch):
+    """An error is raised once all items are done (none is left writing); a map called from
+    a worker runs serially there instead of waiting on its own pool (two threads, both
+    busy with an outer item each, would otherwise wait on each other for ever)."""
+    monkeypatch.setenv(threads.ENV, "2")
+    done: list[int] = []
+
+    def item(i: int) -> int:
+        if i == 0:
+            raise ValueError("item 0 is bad")
+        time.sleep(0.01)
+        done.append(i)
+        return i
+
+    with pytest.raises(ValueError, match="item 0 is bad"):
+        threads.parallel_map(item, range(4))
+    assert sorted(done) == [1, 2, 3]
+
+    def outer(i: int) -> list[int]:
+        return threads.parallel_map(lambda j: 10 * i + j, range(3))
+
+    assert threads.parallel_map(outer, range(2)) == [[0, 1, 2], [10, 11, 12]]
+
+
+def test_parallel_map_makes_its_pool_again_in_a_forked_process(monkeypatch):
+    """A pool's threads do not survive a fork: a new process id gets a new pool."""
+    monkeypatch.setenv(threads.ENV, "2")
+    threads.parallel_map(abs, [-1, -2])
+    first = threads._worker_pool(2)
+    assert threads._worker_pool(2) is first
+    monkeypatch.setattr(threads.os, "getpid", lambda: -12345)
+    assert threads._worker_pool(2) is not first
+    assert threads.parallel_map(abs, [-1, -2]) == [1, 2]

@@ -3,6 +3,8 @@ finite differences of the assembled energy, rigid-body invariance, zero-eigenval
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -78,14 +80,7 @@ def test_an_evaluation_in_chunks_of_three_elements_is_the_one_in_a_single_chunk(
     import barhinge.assembly as assembly
 
     def build() -> BarHingeModel:
-        if mi < len(MODELS):
-            return models()[mi]
-        m = BarHingeModel.from_pattern(bh.families.miura(2, 2, fold=30.0), "N5B8", MAT)
-        h = [set(x) for x in np.asarray(m.hinges)]
-        near = [(i, j) for i in range(len(h)) for j in range(i + 1, len(h)) if h[i] & h[j]]
-        pairs = np.array(near[:: max(1, len(near) // 30)])
-        k = np.random.default_rng(2).uniform(-0.5, 0.5, len(pairs))
-        return m.with_(hinge_pairs=pairs, pair_k=k)
+        return models()[mi] if mi < len(MODELS) else _coupled_miura()
 
     whole = build()
     X = perturbed(whole, 20 + mi)
@@ -104,6 +99,76 @@ def test_an_evaluation_in_chunks_of_three_elements_is_the_one_in_a_single_chunk(
         assert np.abs(ev.K.toarray() - K).max() <= 1e-12 * np.abs(K).max()
     else:
         assert len(m.hinge_pairs) > 10
+
+
+@pytest.mark.parametrize("mi", range(len(MODELS) + 1))
+def test_an_evaluation_on_worker_threads_is_the_one_on_a_single_thread(
+    mi: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The kernels' passes (two hinges each here) and the nine components of the block sums
+    run side by side on the worker threads, the hinge laws called from them: energy, force
+    and tangent are those of one thread to the last bit, and the oracle's."""
+    import barhinge.assembly as assembly
+    import barhinge.kernels.geometry as geometry
+    from barhinge.linalg import threads
+
+    m = MODELS[mi] if mi < len(MODELS) else _coupled_miura()
+    X = perturbed(m, 40 + mi)
+    monkeypatch.setattr(geometry, "HESSIAN_CHUNK", 2)
+    monkeypatch.setattr(geometry, "GRADIENT_CHUNK", 2)
+    monkeypatch.setattr(assembly, "PARALLEL_INSTANCES", 1)
+    names: set[str] = set()
+    kernel = geometry._hinge_hessian_packed_t
+
+    def spy(*args, **kwargs):
+        names.add(threading.current_thread().name)
+        return kernel(*args, **kwargs)
+
+    monkeypatch.setattr(geometry, "_hinge_hessian_packed_t", spy)
+    runs = []
+    for count in ("1", "3"):
+        monkeypatch.setenv(threads.ENV, count)
+        runs.append((m.evaluate(X), m.evaluate(X, tangent=False)))
+    (one, one_f), (three, three_f) = runs
+    if m.n_hinges > 2:  # more than one pass
+        assert any(name.startswith("barhinge-worker") for name in names)
+    assert three.energy == one.energy
+    assert np.array_equal(three.force, one.force)
+    assert np.array_equal(three_f.force, one_f.force)
+    assert np.array_equal(three.K.data, one.K.data)
+    if mi < len(MODELS):
+        E, f, K = assemble_reference(m, X)
+        assert three.energy == pytest.approx(E, rel=1e-12)
+        assert np.abs(three.force - f).max() <= 1e-12 * np.abs(f).max()
+        assert np.abs(three.K.toarray() - K).max() <= 1e-12 * np.abs(K).max()
+
+
+def _coupled_miura() -> BarHingeModel:
+    """A 2 x 2 Miura whose neighbouring hinges are coupled (the couplings' tangent reads the
+    hinge gradients the kernels' passes write)."""
+    m = BarHingeModel.from_pattern(bh.families.miura(2, 2, fold=30.0), "N5B8", MAT)
+    h = [set(x) for x in np.asarray(m.hinges)]
+    near = [(i, j) for i in range(len(h)) for j in range(i + 1, len(h)) if h[i] & h[j]]
+    pairs = np.array(near[:: max(1, len(near) // 30)])
+    k = np.random.default_rng(2).uniform(-0.5, 0.5, len(pairs))
+    return m.with_(hinge_pairs=pairs, pair_k=k)
+
+
+def test_a_miura_sheet_evaluated_on_worker_threads_is_the_one_on_a_single_thread(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """At the default pass sizes (a 20 x 20 sheet has two passes of the Hessian kernel and
+    sums its hinges' components side by side): the same tangent and force to the last bit."""
+    from barhinge.linalg import threads
+
+    m = BarHingeModel.from_pattern(bh.families.miura(20, 20, fold=30.0), "N5B8", MAT)
+    X = perturbed(m, 3, amp=1e-3)
+    runs = []
+    for count in ("1", "2"):
+        monkeypatch.setenv(threads.ENV, count)
+        runs.append(m.evaluate(X))
+    assert np.array_equal(runs[0].K.data, runs[1].K.data)
+    assert np.array_equal(runs[0].force, runs[1].force)
 
 
 @pytest.mark.parametrize("mi", range(len(MODELS)))
