@@ -22,8 +22,9 @@ group, the corrections by kind (Newton, accelerated, chord, damped), those that 
 residual and the failed increments; and, per fold, the flat start's hardest step (the most
 factorisations among the steps before the last group) iterate by iterate.
 
-``--threads N`` fixes every library's thread count (``BARHINGE_THREADS``; default this
-machine's cores), in the fold and in its refactorisations alike. ``--publish`` writes the
+``--threads N`` fixes the thread count of MKL and of the worker threads
+(``BARHINGE_THREADS``; default this machine's cores), in the fold and in its
+refactorisations alike. ``--publish`` writes the
 table into docs/solver-performance.md (between the ``steps`` markers).
 """
 

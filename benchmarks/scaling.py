@@ -28,8 +28,12 @@ together.
 ``--publish`` writes the tables into docs/solver-performance.md (between the ``scaling``
 markers), using :func:`barhinge._publish.write_between`.
 
-``--threads N`` fixes the thread count of every library (``BARHINGE_THREADS=N``) in each
-size's process, fold and floor alike (default: this machine's cores): under the default
+Every row records the barhinge commit it was folded at; rows kept from an earlier commit are
+named under the table.
+
+``--threads N`` fixes the thread count of MKL (PARDISO) and of barhinge's worker threads
+(``BARHINGE_THREADS=N``) in each size's process, fold and floor alike (default: this
+machine's cores; numpy's small dense calls keep one thread): under the default
 ``auto`` policy the fold would take the cores the load average leaves free when it starts,
 while a bare factorisation outside the solver keeps the library's own default, and the ratio
 of the two would move with the load the previous size left.
@@ -377,11 +381,52 @@ def _threads_line(rows: list[dict]) -> str:
     counts = sorted({str(r.get("threads", "-")) for r in rows})
     if len(counts) == 1:
         return (
-            f"Every library ran on {counts[0]} thread(s) (`BARHINGE_THREADS={counts[0]}`), "
-            "in the fold and in its floor alike."
+            f"MKL (PARDISO) and the element kernels' worker threads ran on {counts[0]} "
+            f"thread(s) (`BARHINGE_THREADS={counts[0]}`), in the fold and in its floor alike."
         )
     per = ", ".join(f"n = {r['n']} {r['material']}: {r.get('threads', '-')}" for r in rows)
-    return f"Threads of every library (`BARHINGE_THREADS`), fold and floor alike: {per}."
+    return (
+        f"Threads of MKL and the worker threads (`BARHINGE_THREADS`), fold and floor alike: {per}."
+    )
+
+
+def source_commit() -> str:
+    """The barhinge commit this script folds with (``git rev-parse --short HEAD`` of the
+    package's checkout, ``+`` where it has uncommitted changes), ``unknown`` outside git."""
+    import barhinge
+
+    where = str(Path(barhinge.__file__).resolve().parent)
+    try:
+        head = subprocess.run(
+            ["git", "-C", where, "rev-parse", "--short", "HEAD"],
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "-C", where, "status", "--porcelain", "--", where],
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+    return head + ("+" if dirty else "")
+
+
+def commit_lines(rows: list[dict], commit: str) -> list[str]:
+    """A line naming the rows kept from another commit than ``commit`` (``--rows``)."""
+    older = [r for r in rows if r.get("commit") != commit]
+    if not older:
+        return []
+    named = "; ".join(
+        f"n = {r['n']} ({r['material']}) at commit {r.get('commit', 'unknown')}" for r in older
+    )
+    return [
+        "",
+        f"Rows kept from an earlier run (`--rows`): {named}. The other rows were folded at "
+        f"commit {commit}.",
+    ]
 
 
 def _steps(steps: list[int] | None) -> str:
@@ -620,7 +665,7 @@ def ten_million_lines(big: dict | None, rows: list[dict], steps: int) -> list[st
 
 #: what a kept row must hold to be published (rows of older versions of this script are
 #: folded again)
-ROW_KEYS = frozenset({"fold_peak_mb", "threads"})
+ROW_KEYS = frozenset({"fold_peak_mb", "threads", "commit"})
 
 
 def _row_complete(row: dict) -> bool:
@@ -676,7 +721,7 @@ def main() -> None:
         "--threads",
         type=int,
         default=None,
-        help="threads of every library in each size's process (default: the machine's cores)",
+        help="threads of MKL and the worker threads in each size's process (default: cores)",
     )
     a = ap.parse_args()
     if a.one is not None or a.one_pieces is not None:
@@ -698,6 +743,7 @@ def main() -> None:
         raise SystemExit(f"--threads {a.threads}: expected a whole number >= 1")
 
     rows, failed = [], []
+    commit = source_commit()
     kept = _load_rows(a.rows)
     for mat in a.materials:
         for n in a.sizes if mat == "quasi-rigid" else a.compliant_sizes:
@@ -721,10 +767,12 @@ def main() -> None:
                 print(f"error: n = {n}, {mat}: {exc}", file=sys.stderr, flush=True)
                 failed.append(f"n = {n}, {mat}: {exc}")
                 continue
+            row["commit"] = commit
             rows.append(row)
             _keep_row(a.rows, kept, key, row)
             print(fold_table(rows, a.steps)[-1], flush=True)
-    lines = fold_table(rows, a.steps) + held_lines(rows) + stability_lines(rows)
+    lines = fold_table(rows, a.steps) + commit_lines(rows, commit)
+    lines += held_lines(rows) + stability_lines(rows)
     lines += exponent_lines(rows)
     lines += [f"\n**Not completed**: {f}" for f in failed]
     for n in a.pieces:

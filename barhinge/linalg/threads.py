@@ -24,7 +24,10 @@ The policy is set by the environment variable ``BARHINGE_THREADS``:
     barhinge sets no limits (the libraries' own defaults, or ``OMP_NUM_THREADS`` and the
     like);
 an integer ``n``
-    every library ``n`` threads in both kinds of work.
+    MKL (PARDISO) ``n`` threads instead of the free cores, and ``n`` worker threads; the small
+    dense calls keep one BLAS thread as under ``auto`` (a BLAS library's threads spin after
+    each call, and with two of them OpenBLAS took a core from every tangent evaluation of a
+    fold).
 
 Limits are applied with threadpoolctl for the duration of one public call and restored
 afterwards.
@@ -147,39 +150,33 @@ def free_cores() -> int:
 
 @contextlib.contextmanager
 def dense_calls() -> Iterator[None]:
-    """One BLAS thread for small dense linear algebra (policy ``auto``), ``n`` for a fixed
-    policy, nothing changed for ``off``."""
-    p = policy()
-    if p == "off":
+    """One BLAS thread for small dense linear algebra (policies ``auto`` and ``n``), nothing
+    changed for ``off``."""
+    if policy() == "off":
         yield
         return
-    with threadpool_limits(limits=1 if p == "auto" else p, user_api="blas"):
+    with threadpool_limits(limits=1, user_api="blas"):
         yield
 
 
 @contextlib.contextmanager
 def sparse_solves() -> Iterator[None]:
-    """MKL (PARDISO) threads matched to the free cores (policy ``auto``), ``n`` for a fixed
-    policy, nothing changed for ``off``. Dense BLAS keeps one thread under ``auto``: the
-    solver's dense work is small."""
+    """MKL (PARDISO) threads matched to the free cores (policy ``auto``) or ``n`` (a fixed
+    policy), any other BLAS one thread (the solver's dense work is small); nothing changed
+    for ``off``."""
     p = policy()
     if p == "off":
         yield
         return
-    if p == "auto":
-        # by library: MKL (PARDISO's threads) to the free cores, any other BLAS to one
-        controller = ThreadpoolController()
-        with contextlib.ExitStack() as stack:
-            mkl = controller.select(internal_api="mkl")
-            if mkl.lib_controllers:
-                stack.enter_context(mkl.limit(limits=free_cores()))
-            for api in ("openblas", "blis"):
-                other = controller.select(internal_api=api)
-                if other.lib_controllers:
-                    stack.enter_context(other.limit(limits=1))
-            yield
-        return
-    with threadpool_limits(limits=p):
+    controller = ThreadpoolController()
+    with contextlib.ExitStack() as stack:
+        mkl = controller.select(internal_api="mkl")
+        if mkl.lib_controllers:
+            stack.enter_context(mkl.limit(limits=free_cores() if p == "auto" else p))
+        for api in ("openblas", "blis"):
+            other = controller.select(internal_api=api)
+            if other.lib_controllers:
+                stack.enter_context(other.limit(limits=1))
         yield
 
 

@@ -6,6 +6,9 @@ reading of what the BLAS libraries are set to)."""
 from __future__ import annotations
 
 import importlib
+import os
+import subprocess
+import sys
 import threading
 import time
 
@@ -69,6 +72,38 @@ def test_off_changes_nothing_and_a_number_sets_every_library(monkeypatch):
     monkeypatch.setenv(threads.ENV, "1")
     with threads.sparse_solves():
         assert set(blas_threads().values()) == {1}
+
+
+def test_a_number_sets_mkl_and_keeps_the_dense_calls_on_one_thread(monkeypatch):
+    """``n`` gives PARDISO (MKL) n threads whatever the load; the small dense calls keep one
+    BLAS thread, whose spinning after each call would take a core from the kernels."""
+    pytest.importorskip("pypardiso")  # loads MKL
+    monkeypatch.setenv(threads.ENV, "3")
+    monkeypatch.setattr(threads, "free_cores", lambda: 1)
+    with threads.sparse_solves():
+        inside = blas_threads()
+    assert inside.pop("mkl") == 3
+    assert set(inside.values()) <= {1}
+    with threads.dense_calls():
+        assert set(blas_threads().values()) == {1}
+
+
+def test_mkl_threads_sleep_after_a_call_unless_the_user_says_otherwise():
+    """The PARDISO backend sets ``KMP_BLOCKTIME=0`` where the environment has none (read in a
+    fresh process: the OpenMP runtime reads it when MKL loads)."""
+    pytest.importorskip("pypardiso")
+    code = (
+        "import os; from barhinge.linalg.backends import PardisoBackend; PardisoBackend(); "
+        "print(os.environ['KMP_BLOCKTIME'])"
+    )
+    for given, want in ((None, "0"), ("50", "50")):
+        env = {k: v for k, v in os.environ.items() if k != "KMP_BLOCKTIME"}
+        if given is not None:
+            env["KMP_BLOCKTIME"] = given
+        out = subprocess.run(
+            [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+        )
+        assert out.stdout.strip() == want
 
 
 def test_free_cores_subtracts_the_load(monkeypatch):
