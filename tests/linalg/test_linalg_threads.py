@@ -64,7 +64,7 @@ def test_sparse_solves_match_mkl_to_the_free_cores(monkeypatch):
     assert blas_threads() == before
 
 
-def test_off_changes_nothing_and_a_number_sets_every_library(monkeypatch):
+def test_off_changes_nothing_and_one_sets_every_library_to_one(monkeypatch):
     before = blas_threads()
     monkeypatch.setenv(threads.ENV, "off")
     with threads.dense_calls(), threads.sparse_solves():
