@@ -300,6 +300,7 @@ class Assembler:
         del rn
         self._blocks_indptr = indptr_n  # (N + 1,) the full pattern's blocks of each node row
         deg = np.diff(indptr_n)
+        self._max_row_blocks = int(deg.max(initial=0))  # the most blocks of one node row
         seg_len = np.repeat(3 * deg, 3)  # dof row (A, i) holds 3 entries per neighbour
         seg_start = np.zeros(n + 1, itype)
         np.cumsum(seg_len, out=seg_start[1:])
@@ -480,7 +481,7 @@ class Assembler:
         flat = data[: 9 * nblk]
         ip = self._blocks_indptr
         a1 = self.n_nodes
-        read = np.empty(min(SUMS_FILL_CHUNK + 9 * int(np.diff(ip).max(initial=0)), self.nnz))
+        read = np.empty(min(SUMS_FILL_CHUNK + 9 * self._max_row_blocks, self.nnz))
 
         def gather(part: slice) -> None:
             np.take(flat, self._gather[part], out=read[part.start - p0 : part.stop - p0])
