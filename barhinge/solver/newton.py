@@ -357,7 +357,7 @@ class _Driver:
         Not after a failed increment or inside cut-backs, where the retries
         (:meth:`_retry`) are in charge.
 
-        On a smooth stretch (``STEADY_EXTRAPOLATION``: the last whole step started from the
+        On a smooth stretch (``STEADY_EXTRAPOLATION``: the last increment started from the
         high-degree extrapolation and took one correction) the extrapolation is the start
         alone, unevaluated: the first iteration assembles its tangent anyway."""
         ctx, nx = self.ctx, len(st.x)
