@@ -59,11 +59,10 @@ def test_two_force_evaluations_saved_per_smooth_step(pair) -> None:
     assert ts["n_tangent"] <= tc["n_tangent"]
 
 
-def test_a_slow_step_brings_the_comparison_back(monkeypatch) -> None:
+def test_a_slow_step_brings_the_comparison_back() -> None:
     """An increment that needed more than one correction (or failed) is not a smooth stretch:
     the next prediction compares the candidates again."""
     drv = newton._Driver(miura_scene(4, 0.0, 10, material="quasi-rigid"))
-    drv._pred_extrapolated = True
     for n_iter, slow, hard, expected in (
         (1, False, False, True),
         (2, False, False, False),
