@@ -611,18 +611,30 @@ def pieces_lines(r: dict, rows: list[dict], steps: int) -> list[str]:
     return lines
 
 
-def ten_million_lines(big: dict | None, rows: list[dict], steps: int) -> list[str]:
+def ten_million_lines(
+    big: dict | None, rows: list[dict], steps: int, kept: frozenset[int] = frozenset()
+) -> list[str]:
     """Extrapolate refactorisation time and memory to 10 M DOF from the largest measured sizes:
     the refactorisation from the full folds and, where given, the measured pieces of a larger
     sheet; the memory from the full folds' own peaks only (a Newton iteration's pieces peak
-    lower than a whole fold, which also holds its path and its stability counts)."""
+    lower than a whole fold, which also holds its path and its stability counts).
+
+    The refactorisation's exponent compares timings of this run only (``kept``: the sizes
+    whose rows were kept from an earlier run, ``--rows``): the machine's speed moves from day
+    to day, and a kept row's floor against a fresh one would move the exponent with it. The
+    pieces of a sheet (measured in this run) stand in for its kept full fold."""
     quasi = [q for q in rows if q["material"] == "quasi-rigid"]
     if len(quasi) < 2:
         return []
-    times = [(q["dof"], q["refactorisation"]) for q in quasi]
-    if big is not None and all(q["dof"] != big["dof"] for q in quasi):
-        times.append((big["dof"], big["fact"]))
-    (d0, f0), (d1, f1) = sorted(times)[-2:]  # the two largest sheets
+    fresh = {q["dof"]: q["refactorisation"] for q in quasi if q["n"] not in kept}
+    if big is not None:
+        fresh.setdefault(big["dof"], big["fact"])
+    same_run = len(fresh) >= 2
+    if same_run:
+        times = sorted(fresh.items())
+    else:  # too few fresh timings: every row, whatever its run
+        times = sorted({q["dof"]: q["refactorisation"] for q in quasi}.items())
+    (d0, f0), (d1, f1) = times[-2:]  # the two largest sheets
     # memory above the libraries' own (the smallest sheet's fold) scales with the sheet
     base = min(q["fold_peak_mb"] for q in quasi)
     (e0, m0), (e1, m1) = sorted((q["dof"], q["fold_peak_mb"]) for q in quasi)[-2:]
@@ -648,7 +660,9 @@ def ten_million_lines(big: dict | None, rows: list[dict], steps: int) -> list[st
         "### A 10 M DOF sheet (estimate)",
         "",
         f"Extrapolated from the largest sheets measured above: the refactorisation grows like "
-        f"DOF^{pf:.2f} (from {d0} to {d1} DOF) and a fold's peak memory above the libraries' "
+        f"DOF^{pf:.2f} (from {d0} to {d1} DOF, "
+        f"{'both timed in this run' if same_run else 'timed in different runs'}) and a "
+        f"fold's peak memory above the libraries' "
         f"{base:.0f} MB like DOF^{pm:.2f} (the full folds of {e0} and {e1} DOF). A sheet of "
         f"10 M DOF (a Miura of about "
         f"{cells} x {cells} cells) would need about {mem10 / 1024:.1f} GB and "
@@ -745,11 +759,14 @@ def main() -> None:
     rows, failed = [], []
     commit = source_commit()
     kept = _load_rows(a.rows)
+    kept_sizes: set[int] = set()  # quasi-rigid sizes whose rows were kept, not folded now
     for mat in a.materials:
         for n in a.sizes if mat == "quasi-rigid" else a.compliant_sizes:
             key = _row_key(n, mat, a.steps)
             if key in kept and not a.fresh and _row_complete(kept[key]):
                 rows.append(kept[key])
+                if mat == "quasi-rigid":
+                    kept_sizes.add(n)
                 print(f"n = {n}, {mat}: row kept in {a.rows}", file=sys.stderr, flush=True)
                 continue
             if key in kept and not a.fresh:
@@ -777,9 +794,10 @@ def main() -> None:
     lines += [f"\n**Not completed**: {f}" for f in failed]
     for n in a.pieces:
         big = _child(["--one-pieces", str(n)], a.threads)
-        lines += pieces_lines(big, rows, a.steps) + ten_million_lines(big, rows, a.steps)
+        lines += pieces_lines(big, rows, a.steps)
+        lines += ten_million_lines(big, rows, a.steps, frozenset(kept_sizes))
     if not a.pieces:
-        lines += ten_million_lines(None, rows, a.steps)
+        lines += ten_million_lines(None, rows, a.steps, frozenset(kept_sizes))
     print("\n".join(lines), flush=True)
     if a.publish:
         from barhinge._publish import generated_stamp, write_between

@@ -142,3 +142,31 @@ def test_step_clock_benchmark_groups_add_up_to_the_fold():
     assert run["fold_factorisation"] == pytest.approx(float(np.median(samples)))
     total = last["factorize"]
     assert min(samples) > 0.0 and max(samples) <= total
+
+
+def test_ten_million_estimate_compares_timings_of_one_run():
+    """benchmarks/scaling.py: the 10 M DOF paragraph fits the refactorisation's exponent on
+    timings of the same run. A row kept from an earlier run gives way to the pieces of that
+    sheet measured now; with too few fresh timings every row is used, and the paragraph says
+    which. The exponent is the log-log slope of the two largest sheets."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+    import scaling
+
+    def row(n: int, dof: int, refac: float) -> dict:
+        return {"material": "quasi-rigid", "n": n, "dof": dof, "refactorisation": refac,
+                "fold_peak_mb": 100.0 + dof / 1000.0}  # fmt: skip
+
+    rows = [row(70, 1000, 1.0), row(100, 2000, 2.0), row(200, 8000, 4.0)]
+    big = {"dof": 8000, "fact": 8.0}  # the 200 x 200 pieces, timed in this run
+    text = " ".join(scaling.ten_million_lines(big, rows, 50, frozenset({200})))
+    # fresh: 2000 -> 2.0 s and 8000 -> 8.0 s (the pieces, not the kept row's 4.0 s)
+    assert "DOF^1.00 (from 2000 to 8000 DOF, both timed in this run)" in text
+    text = " ".join(scaling.ten_million_lines(None, rows, 50, frozenset({100, 200})))
+    # one fresh timing only: all rows, 2000 -> 2.0 s and 8000 -> 4.0 s, slope 0.5
+    assert "DOF^0.50 (from 2000 to 8000 DOF, timed in different runs)" in text
+    text = " ".join(scaling.ten_million_lines(big, rows, 50))
+    # nothing kept: the full fold's own floor stands (4.0 s)
+    assert "DOF^0.50 (from 2000 to 8000 DOF, both timed in this run)" in text
