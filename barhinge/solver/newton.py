@@ -369,13 +369,10 @@ class _Driver:
             if STEADY_EXTRAPOLATION and self._steady and whole:
                 # a smooth stretch: the extrapolation alone, its tangent assembled at once
                 self._pred_extrapolated = True
-                new = State(z[:nx].copy(), z[nx:].copy(), lam1, t1)
-                new.x[self.fixed] = ctx.fixed_coords(t1)
-                return new
+                return self._unpacked(z, nx, t1, lam1)
         best: tuple[float, State, Evaluation] | None = None
         for i, z in enumerate(cands):
-            new = State(z[:nx].copy(), z[nx:].copy(), lam1, t1)
-            new.x[self.fixed] = ctx.fixed_coords(t1)
+            new = self._unpacked(z, nx, t1, lam1)
             e = ctx.evaluate(new, tangent=False)
             m = self.conv.merit(e)
             if best is None or m < best[0]:
@@ -499,6 +496,13 @@ class _Driver:
         if ctx.k_act is not None:  # compliant actuators: their springs' ends move
             rhs = rhs + e.terms.G.T @ (ctx.k_act * (ctx.targets(t1) - ctx.targets(st.t)))
         return rhs, c_pred
+
+    def _unpacked(self, z: np.ndarray, nx: int, t1: float, lam1: float) -> State:
+        """The state ``[x, mu] = z`` (``nx`` coordinates first) at ``t1`` (load factor
+        ``lam1``) with the fixed DOFs at their prescribed place."""
+        new = State(z[:nx].copy(), z[nx:].copy(), lam1, t1)
+        new.x[self.fixed] = self.ctx.fixed_coords(t1)
+        return new
 
     def _stepped(self, st: State, dx: np.ndarray, dmu: np.ndarray, t1: float, lam1: float) -> State:
         """``st`` moved by ``(dx, dmu)`` on the free DOFs and multipliers, at ``t1`` (load
