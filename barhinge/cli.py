@@ -1,4 +1,5 @@
-"""Command-line interface: ``barhinge fold | info | dof | patterns | study | render | verify``.
+"""Command-line interface: ``barhinge fold | info | dof | patterns | study | render | view |
+cache | verify``.
 
 The CLI owns the terminal: rich tables and progress bars. :func:`main` is its one error
 boundary: usage mistakes, library errors and unreadable/unwritable files become one line on
@@ -582,6 +583,41 @@ def view(
     if output is None and path.is_dir() and (path / MANIFEST).is_file():
         add_to_manifest(path, [out])  # a result folder lists the viewer as its own
     console.print(f"[green]viewer[/] {out}", highlight=False)
+
+
+# --- commands: cache (calibration answers kept between runs) ---
+
+
+@app.command()
+def cache(
+    clear: Annotated[bool, typer.Option("--clear", help="Remove every kept answer.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+) -> None:
+    """Where the calibration's answers are kept between runs, and how much they hold.
+
+    BARHINGE_CACHE_DIR moves the folder; BARHINGE_CACHE=off turns the cache off.
+    """
+    from barhinge._disk_cache import cache_info, clear_cache
+
+    found = clear_cache() if clear else cache_info()
+    data = {
+        "folder": None if found.folder is None else str(found.folder),
+        "entries": found.entries,
+        "bytes": found.bytes,
+        "cleared": clear,
+    }
+    if as_json:
+        print_json(data)
+    elif found.folder is None:
+        console.print("calibration cache: off (BARHINGE_CACHE=off)", highlight=False)
+    else:
+        what = "removed" if clear else "holds"
+        console.print(
+            f"calibration cache {found.folder}: {what} {found.entries} entries "
+            f"({found.bytes / 1024:.1f} KiB)",
+            highlight=False,
+            soft_wrap=True,
+        )
 
 
 # --- commands: study (sweeps) ---

@@ -1,11 +1,18 @@
 """Whole-process wall time of ``barhinge fold`` on the default scene against its solve.
 
 Usage: python benchmarks/bench_fold_overhead.py [--repeat 7] [--pictures none] [--vs DIR]
+                                                [--cache both|warm|cold]
 
 Runs ``barhinge fold --out TMP`` in fresh processes (start-up, imports, the scene, the solve
 and every file of the run included), reads the solve's own wall time from ``summary.json``
 (``wall_time_s``: the solver's clock around the steps) and prints the medians and the median
 of the per-run ratio total / solve. The target of issue 20 is a ratio of at most 3.
+
+The calibration's answers are kept between processes (``BARHINGE_CACHE_DIR``,
+docs/calibration.md). ``--cache warm`` times runs that find them (every run after the first
+on a machine, the warm-up filling a cache folder of this benchmark's own); ``--cache cold``
+gives every run an empty cache folder (the first run on a machine); ``both`` (the default)
+prints both.
 
 ``--vs DIR`` alternates the runs with runs of another checkout (``PYTHONPATH=DIR``), so
 both see the same machine load, and prints both.
@@ -19,6 +26,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shutil
 import statistics
 import subprocess
 import sys
@@ -29,8 +37,11 @@ from pathlib import Path
 CMD = "import sys; from barhinge.cli import main; sys.argv[0] = 'barhinge'; sys.exit(main())"
 
 
-def one_run(folder: Path, pictures: str, pythonpath: str | None = None) -> tuple[float, float]:
-    """(total wall s, solve wall s) of one ``barhinge fold`` process."""
+def one_run(
+    folder: Path, pictures: str, pythonpath: str | None = None, cache: Path | None = None
+) -> tuple[float, float]:
+    """(total wall s, solve wall s) of one ``barhinge fold`` process (its calibration cache
+    in the folder ``cache``)."""
     out = folder / "out"
     args = [sys.executable, "-c", CMD, "fold", "--out", str(out), "--overwrite"]
     args += ["--pictures", pictures]
@@ -38,6 +49,9 @@ def one_run(folder: Path, pictures: str, pythonpath: str | None = None) -> tuple
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
     if pythonpath is not None:
         env["PYTHONPATH"] = pythonpath
+    env.pop("BARHINGE_CACHE", None)
+    if cache is not None:
+        env["BARHINGE_CACHE_DIR"] = str(cache)
     proc = subprocess.run(args, capture_output=True, text=True, env=env)
     total = time.perf_counter() - t
     if proc.returncode:
@@ -51,25 +65,35 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--pictures", default="none", choices=("none", "png", "all"))
     ap.add_argument("--vs", default=None, help="another checkout to alternate with")
+    ap.add_argument("--cache", default="both", choices=("both", "warm", "cold"))
     args = ap.parse_args()
     here = str(Path(__file__).resolve().parents[1])
     checkouts = {"this checkout": here} | ({"--vs " + args.vs: args.vs} if args.vs else {})
-    runs: dict[str, list[tuple[float, float]]] = {k: [] for k in checkouts}
+    modes = ("warm", "cold") if args.cache == "both" else (args.cache,)
+    runs: dict[tuple[str, str], list[tuple[float, float]]] = {
+        (name, mode): [] for name in checkouts for mode in modes
+    }
     with tempfile.TemporaryDirectory() as tmp:
-        for path in checkouts.values():
-            one_run(Path(tmp), args.pictures, path)  # warm-up: compiled bytecode, page cache
-        for _ in range(args.repeat):
+        folder = Path(tmp)
+        warm = {name: folder / f"warm-{j}" for j, name in enumerate(checkouts)}
+        for name, path in checkouts.items():  # warm-up: bytecode, page cache, warm cache
+            one_run(folder, args.pictures, path, warm[name])
+        for i in range(args.repeat):
             for name, path in checkouts.items():
-                runs[name].append(one_run(Path(tmp), args.pictures, path))
+                for mode in modes:
+                    cache = warm[name] if mode == "warm" else folder / f"cold-{i}"
+                    runs[name, mode].append(one_run(folder, args.pictures, path, cache))
+                    if mode == "cold":
+                        shutil.rmtree(cache, ignore_errors=True)
     print(
         f"barhinge fold (default scene, --pictures {args.pictures}), {args.repeat} runs, "
         f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}"
     )
-    for name, rs in runs.items():
+    for (name, mode), rs in runs.items():
         total = [t for t, _ in rs]
         solve = [s for _, s in rs]
         ratio = [t / s for t, s in rs]
-        print(f"{name}:")
+        print(f"{name}, {mode} calibration cache:")
         print(f"  total wall s   median {statistics.median(total):.2f} (min {min(total):.2f})")
         print(f"  solve wall s   median {statistics.median(solve):.2f} (min {min(solve):.2f})")
         print(f"  total / solve  median {statistics.median(ratio):.2f} (min {min(ratio):.2f}, "

@@ -2,9 +2,15 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
+
+# The tests check what the code computes, not what an earlier run kept: the calibration
+# cache (barhinge._disk_cache) is off for the whole session, subprocesses included. The
+# tests of the cache turn it on in a temporary folder of their own.
+os.environ["BARHINGE_CACHE"] = "off"
 
 REPO = Path(__file__).resolve().parents[1]
 #: real crease patterns drawn by others (Origami Simulator, FOLD spec), copied into the

@@ -43,6 +43,7 @@ LAYERS: list[tuple[str, list[str]]] = [
             "barhinge._deprecated",
             "barhinge._publish",
             "barhinge._study_args",
+            "barhinge._disk_cache",
         ],
     ),
     ("linalg", ["barhinge.linalg", "barhinge.linalg.*"]),

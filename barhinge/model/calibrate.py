@@ -37,6 +37,7 @@ import logging
 
 import numpy as np
 
+from barhinge._disk_cache import load_array, make_key, store_array
 from barhinge.errors import ConfigError
 from barhinge.model.material import Material
 from barhinge.model.topology import Topology
@@ -180,14 +181,10 @@ def _bounded_fits(G: np.ndarray, y: np.ndarray, a_min: np.ndarray) -> np.ndarray
 
     The problem is made dimensionless first (areas in units of ``a_min``, rows in units of
     the largest modulus), so the answer scales exactly with the panel: the same shape in
-    millimetres or metres gets the same bar stiffnesses ``E A / L`` per unit thickness. Where
-    several area sets fit equally well (more bars than moduli), the smallest one is taken
-    (a ridge of weight ``BOUNDED_FIT_RIDGE`` relative to the weakest direction the moduli
-    fix), the bounded counterpart of the minimum-norm ``pinv`` fit used where no bound is
-    active. Faces of the same shape are solved once (keyed on the rounded dimensionless
-    problem)."""
-    from scipy.optimize import lsq_linear  # lazy: scipy.optimize costs ~0.15 s to import
-
+    millimetres or metres gets the same bar stiffnesses ``E A / L`` per unit thickness. Faces
+    of the same shape are solved once (keyed on the rounded dimensionless problem), and each
+    answer is kept between processes (:mod:`barhinge._disk_cache`, keyed on the exact
+    problem), so that a second run of the same sheet does not import ``scipy.optimize``."""
     y_scale = np.abs(y).max(axis=1)
     Gn = G * (a_min / y_scale)[:, None, None]  # unknowns b = a / a_min >= 1
     yn = y / y_scale[:, None]
@@ -195,29 +192,47 @@ def _bounded_fits(G: np.ndarray, y: np.ndarray, a_min: np.ndarray) -> np.ndarray
     _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
     out = np.empty((len(first), G.shape[2]))
     for u, f in enumerate(first):
-        Gf = Gn[f]
-        cols = Gf / np.linalg.norm(Gf, axis=0)
-        group = -np.ones(Gf.shape[1], dtype=np.int64)
-        ng = 0
-        for b in range(Gf.shape[1]):
-            if group[b] >= 0:
-                continue
-            same = (group < 0) & (np.abs(cols - cols[:, [b]]).max(axis=0) < 1e-9)
-            group[same] = ng
-            ng += 1
-        Gt = np.zeros((Gf.shape[0], ng))
-        np.add.at(Gt.T, group, Gf.T)
-        # |a|^2 = sum over groups of (bars in the group) * b_g^2: the ridge rows, weighted
-        # against the weakest direction the moduli fix (so that a heavily weighted row, the
-        # dilation rule's, does not let the ridge bend the fit of the others)
-        sv = np.linalg.svd(Gt, compute_uv=False)
-        ridge = np.sqrt(BOUNDED_FIT_RIDGE) * float(sv[sv > 1e-12 * sv[0]].min())
-        R = np.diag(ridge * np.sqrt(np.bincount(group, minlength=ng)))
-        A = np.vstack([Gt, R])
-        rhs = np.concatenate([yn[f], np.zeros(ng)])
-        res = lsq_linear(A, rhs, bounds=(1.0, np.inf), method="bvls")
-        out[u] = res.x[group]
+        entry = make_key(_BOUNDED_FIT, Gn[f], yn[f], BOUNDED_FIT_RIDGE, libraries=("scipy",))
+        b = load_array(_BOUNDED_FIT, entry, (G.shape[2],))
+        if b is None:
+            b = _bounded_fit(Gn[f], yn[f])
+            store_array(_BOUNDED_FIT, entry, b)
+        out[u] = b
     return out[inv.ravel()] * a_min[:, None]
+
+
+#: namespace of the bounded fits in the cache kept between processes
+_BOUNDED_FIT = "bounded_bar_fit"
+
+
+def _bounded_fit(Gf: np.ndarray, yf: np.ndarray) -> np.ndarray:
+    """(m,) dimensionless areas ``b >= 1`` of one face: ``Gf b ~ yf`` (Gf (r, m)), bars of
+    equal direction tied; of equally good area sets the smallest (a ridge of weight
+    ``BOUNDED_FIT_RIDGE`` relative to the weakest direction the moduli fix), the bounded
+    counterpart of the minimum-norm ``pinv`` fit used where no bound is active."""
+    from scipy.optimize import lsq_linear  # lazy: scipy.optimize costs ~0.15 s to import
+
+    cols = Gf / np.linalg.norm(Gf, axis=0)
+    group = -np.ones(Gf.shape[1], dtype=np.int64)
+    ng = 0
+    for b in range(Gf.shape[1]):
+        if group[b] >= 0:
+            continue
+        same = (group < 0) & (np.abs(cols - cols[:, [b]]).max(axis=0) < 1e-9)
+        group[same] = ng
+        ng += 1
+    Gt = np.zeros((Gf.shape[0], ng))
+    np.add.at(Gt.T, group, Gf.T)
+    # |a|^2 = sum over groups of (bars in the group) * b_g^2: the ridge rows, weighted
+    # against the weakest direction the moduli fix (so that a heavily weighted row, the
+    # dilation rule's, does not let the ridge bend the fit of the others)
+    sv = np.linalg.svd(Gt, compute_uv=False)
+    ridge = np.sqrt(BOUNDED_FIT_RIDGE) * float(sv[sv > 1e-12 * sv[0]].min())
+    R = np.diag(ridge * np.sqrt(np.bincount(group, minlength=ng)))
+    A = np.vstack([Gt, R])
+    rhs = np.concatenate([yf, np.zeros(ng)])
+    res = lsq_linear(A, rhs, bounds=(1.0, np.inf), method="bvls")
+    return np.asarray(res.x, dtype=np.float64)[group]
 
 
 def _half_diagonal_ties(

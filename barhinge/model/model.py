@@ -21,6 +21,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from barhinge import _check
+from barhinge._disk_cache import load_array, make_key, store_array
 from barhinge._typing import SCHEMES, Scheme, StrainMeasure
 from barhinge.assembly import Assembler, PackedRows
 from barhinge.errors import ConfigError
@@ -800,26 +801,47 @@ def plate_bend_scale(
         _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
         vals = np.empty(len(first))
         for u, f in enumerate(first):
-            Qf = Q[f]
-            panel = CreasePattern(
-                Qf,
-                np.array([[i, (i + 1) % k] for i in range(k)]),
-                np.array(["B"] * k),
-                faces=[list(range(k))],
-            )
-            m = BarHingeModel.from_pattern(
-                panel, scheme, material, bend_calibration="kirchhoff", fold_stiffness=0.0
-            )
-            Sb = panel_corner_stiffness(m, np.arange(k))
-            Sp = plate_corner_stiffness(Qf, material, refine)
-            tb, tp = float(np.trace(Sb)), float(np.trace(Sp))
-            if not (np.isfinite(tb) and np.isfinite(tp) and tb > 0.0 and tp > 0.0):
-                raise ConfigError(
-                    f"bend_calibration='plate': face {int(faces[sel][f])} has no finite "
-                    "corner-warping stiffness (degenerate panel); use bend_calibration="
-                    "'kirchhoff' or 'filipov'"
-                )
-            vals[u] = tp / tb
+            vals[u] = _plate_bend_ratio(Q[f], scheme, material, refine, int(faces[sel][f]))
         out[sel] = vals[inv.ravel()]
     logger.debug("plate bending calibration: %d faces", len(faces))
     return out
+
+
+#: namespace of the plate bending ratios in the cache kept between processes
+_PLATE_BEND = "plate_bend_ratio"
+
+
+def _plate_bend_ratio(
+    Q: np.ndarray, scheme: Scheme, material: Material, refine: int, face: int
+) -> float:
+    """``trace(S_plate) / trace(S_bar)`` of the flat panel with corners ``Q`` (k, 2) (face
+    number ``face`` for the error message), kept between processes
+    (:mod:`barhinge._disk_cache`, keyed on the exact corners, scheme, material and mesh
+    refinement), so that a second run of the same sheet does not import scikit-fem."""
+    Q = np.ascontiguousarray(Q, dtype=np.float64)
+    inputs = (Q, str(scheme), material.E, material.nu, material.t, int(refine))
+    entry = make_key(_PLATE_BEND, *inputs, libraries=("scipy", "skfem"))
+    kept = load_array(_PLATE_BEND, entry, (1,))
+    if kept is not None:
+        return float(kept[0])
+    k = len(Q)
+    panel = CreasePattern(
+        Q,
+        np.array([[i, (i + 1) % k] for i in range(k)]),
+        np.array(["B"] * k),
+        faces=[list(range(k))],
+    )
+    m = BarHingeModel.from_pattern(
+        panel, scheme, material, bend_calibration="kirchhoff", fold_stiffness=0.0
+    )
+    Sb = panel_corner_stiffness(m, np.arange(k))
+    Sp = plate_corner_stiffness(Q, material, refine)
+    tb, tp = float(np.trace(Sb)), float(np.trace(Sp))
+    if not (np.isfinite(tb) and np.isfinite(tp) and tb > 0.0 and tp > 0.0):
+        raise ConfigError(
+            f"bend_calibration='plate': face {face} has no finite corner-warping stiffness "
+            "(degenerate panel); use bend_calibration='kirchhoff' or 'filipov'"
+        )
+    ratio = tp / tb
+    store_array(_PLATE_BEND, entry, np.array([ratio]))
+    return ratio
