@@ -15,6 +15,8 @@ import importlib.util
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+#: boxes a row holds side by side before it staggers them
+CROWDED = 6
 
 
 def _architecture():
@@ -70,8 +72,10 @@ def draw(out: Path) -> Path:
     for y, lay in enumerate(names):
         row = by_layer[lay]
         for i, r in enumerate(row):
-            # rows zig-zag so that arrows crossing several layers do not run through boxes
-            pos[r] = ((i + 1) / (len(row) + 1) + 0.09 * (-1) ** y, float(y))
+            # rows zig-zag so that arrows crossing several layers do not run through boxes;
+            # a crowded row staggers its boxes up and down so that their labels do not meet
+            dy = 0.2 * (-1) ** i if len(row) > CROWDED else 0.0
+            pos[r] = ((i + 1) / (len(row) + 1) + 0.09 * (-1) ** y, y + dy)
     fig, ax = plt.subplots(figsize=(11, 0.62 * len(names) + 0.8))
     for a, b in arrows:
         (x0, y0), (x1, y1) = pos[a], pos[b]
