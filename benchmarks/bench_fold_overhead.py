@@ -1,12 +1,13 @@
 """Whole-process wall time of ``barhinge fold`` on the default scene against its solve.
 
 Usage: python benchmarks/bench_fold_overhead.py [--repeat 7] [--pictures none] [--vs DIR]
-                                                [--cache both|warm|cold]
+                                                [--cache both|warm|cold] [--publish]
 
 Runs ``barhinge fold --out TMP`` in fresh processes (start-up, imports, the scene, the solve
 and every file of the run included), reads the solve's own wall time from ``summary.json``
 (``wall_time_s``: the solver's clock around the steps) and prints the medians and the median
-of the per-run ratio total / solve. The target of issue 20 is a ratio of at most 3.
+of the per-run ratio total / solve (the target: at most 3). ``--publish`` writes the table
+into docs/solver-performance.md (*The main job end to end*).
 
 The calibration's answers are kept between processes (``BARHINGE_CACHE_DIR``,
 docs/calibration.md). ``--cache warm`` times runs that find them (every run after the first
@@ -66,7 +67,10 @@ def main() -> None:
     ap.add_argument("--pictures", default="none", choices=("none", "png", "all"))
     ap.add_argument("--vs", default=None, help="another checkout to alternate with")
     ap.add_argument("--cache", default="both", choices=("both", "warm", "cold"))
+    ap.add_argument("--publish", action="store_true", help="write the table into docs/")
     args = ap.parse_args()
+    if args.publish and (args.vs or args.pictures != "none" or args.cache != "both"):
+        ap.error("--publish times this checkout with the defaults: drop --vs, --pictures, --cache")
     here = str(Path(__file__).resolve().parents[1])
     checkouts = {"this checkout": here} | ({"--vs " + args.vs: args.vs} if args.vs else {})
     modes = ("warm", "cold") if args.cache == "both" else (args.cache,)
@@ -85,19 +89,44 @@ def main() -> None:
                     runs[name, mode].append(one_run(folder, args.pictures, path, cache))
                     if mode == "cold":
                         shutil.rmtree(cache, ignore_errors=True)
-    print(
+    head = (
         f"barhinge fold (default scene, --pictures {args.pictures}), {args.repeat} runs, "
         f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}"
     )
-    for (name, mode), rs in runs.items():
+    print(head)
+    print("\n".join(table(runs)))
+    if args.publish:
+        from barhinge._publish import generated_stamp, write_between
+
+        cmd = "python benchmarks/bench_fold_overhead.py --publish"
+        if args.repeat != 7:
+            cmd += f" --repeat {args.repeat}"
+        body = [generated_stamp(cmd), "", *table(runs), "", head + "."]
+        doc = Path(here) / "docs" / "solver-performance.md"
+        write_between(doc, "<!-- fold_overhead:start -->", "<!-- fold_overhead:end -->",
+                      "\n".join(body))  # fmt: skip
+        print(f"wrote {doc}")
+
+
+def table(runs: dict[tuple[str, str], list[tuple[float, float]]]) -> list[str]:
+    """Markdown rows: per checkout and cache, the medians of the whole process, the solve,
+    the time around the solve and the ratio."""
+    rows = [
+        "| run | calibration cache | total wall s, median (min) | solve wall s, median (min) "
+        "| around the solve s, median | total / solve, median (min - max) |",
+        "|---|---|---|---|---|---|",
+    ]
+    for (name, mode), rs in runs.items():  # rows: "this checkout" / "--vs DIR", warm / cold
         total = [t for t, _ in rs]
         solve = [s for _, s in rs]
         ratio = [t / s for t, s in rs]
-        print(f"{name}, {mode} calibration cache:")
-        print(f"  total wall s   median {statistics.median(total):.2f} (min {min(total):.2f})")
-        print(f"  solve wall s   median {statistics.median(solve):.2f} (min {min(solve):.2f})")
-        print(f"  total / solve  median {statistics.median(ratio):.2f} (min {min(ratio):.2f}, "
-              f"max {max(ratio):.2f})")  # fmt: skip
+        around = statistics.median(t - s for t, s in rs)
+        rows.append(
+            f"| {name} | {mode} | {statistics.median(total):.2f} ({min(total):.2f}) "
+            f"| {statistics.median(solve):.2f} ({min(solve):.2f}) | {around:.2f} "
+            f"| {statistics.median(ratio):.2f} ({min(ratio):.2f} - {max(ratio):.2f}) |"
+        )
+    return rows
 
 
 if __name__ == "__main__":
