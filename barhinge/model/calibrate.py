@@ -210,7 +210,7 @@ def _bounded_fit(Gf: np.ndarray, yf: np.ndarray) -> np.ndarray:
     equal direction tied; of equally good area sets the smallest (a ridge of weight
     ``BOUNDED_FIT_RIDGE`` relative to the weakest direction the moduli fix), the bounded
     counterpart of the minimum-norm ``pinv`` fit used where no bound is active."""
-    from scipy.optimize import lsq_linear  # lazy: scipy.optimize costs ~0.15 s to import
+    from scipy.optimize import lsq_linear  # lazy: its import costs more than a small fold
 
     cols = Gf / np.linalg.norm(Gf, axis=0)
     group = -np.ones(Gf.shape[1], dtype=np.int64)
